@@ -1,0 +1,139 @@
+// Host-memory owners of point and grid arrays, handing out the views the step uses.
+// The CUDA backend has device twins of these (backend/cuda_storage.h).
+#pragma once
+
+#include <mpm/core/views.h>
+
+#include <cstdint>
+#include <vector>
+
+namespace mpm
+{
+  template <int dim, typename Real>
+  struct HostPoints
+  {
+    std::vector<Real> position[dim], velocity[dim], mass, volume, initial_volume, stress[n_voigt],
+      strain[n_voigt], deformation_gradient[dim * dim], domain_half_length[dim], initial_domain_half_length[dim], plastic_strain;
+    std::vector<int> material;
+
+    int size() const { return static_cast<int>(mass.size()); }
+
+    void resize(const int n)
+    {
+      for (int d = 0; d < dim; ++d)
+        {
+          position[d].resize(n);
+          velocity[d].resize(n);
+          domain_half_length[d].resize(n);
+          initial_domain_half_length[d].resize(n);
+        }
+      for (int c = 0; c < n_voigt; ++c)
+        {
+          stress[c].resize(n);
+          strain[c].resize(n);
+        }
+      for (int c = 0; c < dim * dim; ++c)
+        deformation_gradient[c].resize(n, c % (dim + 1) == 0 ? Real(1) : Real(0));
+      mass.resize(n);
+      volume.resize(n);
+      initial_volume.resize(n);
+      plastic_strain.resize(n);
+      material.resize(n);
+    }
+
+    PointsView<dim, Real> view()
+    {
+      PointsView<dim, Real> v;
+      v.n_points = size();
+      for (int d = 0; d < dim; ++d)
+        {
+          v.position[d]                   = position[d].data();
+          v.velocity[d]                   = velocity[d].data();
+          v.domain_half_length[d]         = domain_half_length[d].data();
+          v.initial_domain_half_length[d] = initial_domain_half_length[d].data();
+        }
+      for (int c = 0; c < n_voigt; ++c)
+        {
+          v.stress[c] = stress[c].data();
+          v.strain[c] = strain[c].data();
+        }
+      for (int c = 0; c < dim * dim; ++c)
+        v.deformation_gradient[c] = deformation_gradient[c].data();
+      v.mass           = mass.data();
+      v.volume         = volume.data();
+      v.initial_volume = initial_volume.data();
+      v.plastic_strain = plastic_strain.data();
+      v.material       = material.data();
+      return v;
+    }
+  };
+
+  template <int dim, typename Real>
+  struct HostGrid
+  {
+    Real                      origin[dim];
+    Real                      h;
+    int                       n_cells[dim];
+    std::vector<int>          lattice_to_node;
+    std::vector<Real>         mass, momentum[dim], force[dim], velocity[dim];
+    std::vector<std::uint8_t> fixed_components;
+
+    // A dense grid whose node numbering is the lattice numbering (standalone use).
+    void make_dense(const Real lower[dim], const Real cell_size, const int cells[dim])
+    {
+      h         = cell_size;
+      long n    = 1;
+      for (int d = 0; d < dim; ++d)
+        {
+          origin[d]  = lower[d];
+          n_cells[d] = cells[d];
+          n *= cells[d] + 1;
+        }
+      lattice_to_node.resize(n);
+      for (long i = 0; i < n; ++i)
+        lattice_to_node[i] = static_cast<int>(i);
+      allocate_nodes(static_cast<int>(n));
+    }
+
+    void allocate_nodes(const int n_nodes)
+    {
+      mass.assign(n_nodes, Real(0));
+      for (int d = 0; d < dim; ++d)
+        {
+          momentum[d].assign(n_nodes, Real(0));
+          force[d].assign(n_nodes, Real(0));
+          velocity[d].assign(n_nodes, Real(0));
+        }
+      fixed_components.assign(n_nodes, 0);
+    }
+
+    // Lattice coordinates of a lattice index (inverse of GridView::node's ordering).
+    void lattice_coordinates(long lattice, int idx[dim]) const
+    {
+      for (int d = 0; d < dim; ++d)
+        {
+          idx[d] = static_cast<int>(lattice % (n_cells[d] + 1));
+          lattice /= n_cells[d] + 1;
+        }
+    }
+
+    GridView<dim, Real> view()
+    {
+      GridView<dim, Real> v;
+      for (int d = 0; d < dim; ++d)
+        {
+          v.origin[d]   = origin[d];
+          v.n_cells[d]  = n_cells[d];
+          v.momentum[d] = momentum[d].data();
+          v.force[d]    = force[d].data();
+          v.velocity[d] = velocity[d].data();
+        }
+      v.h                = h;
+      v.lattice_to_node  = lattice_to_node.data();
+      v.n_nodes          = static_cast<int>(mass.size());
+      v.mass             = mass.data();
+      v.fixed_components = fixed_components.data();
+      return v;
+    }
+  };
+} // namespace mpm

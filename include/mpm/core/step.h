@@ -1,0 +1,421 @@
+// One explicit MPM step with lumped mass, written once for every backend.
+//
+// A Backend says how loops run (see backend/cpu_backend.h): for_each_node,
+// gather_points (a point writes only its own data), scatter_points (points add
+// into nodes through Backend::add), reduce_points. The stages below are what MUSL,
+// USL and USF are made of; musl_step() etc. read as the algorithm (doc/theory.md).
+#pragma once
+
+#include <mpm/core/interpolation.h>
+#include <mpm/core/material/material.h>
+#include <mpm/core/shape_functions.h>
+#include <mpm/core/small_tensor.h>
+#include <mpm/core/views.h>
+
+#include <cmath>
+
+namespace mpm
+{
+  enum class UpdateScheme : int
+  {
+    musl = 0, // modified update stress last (default)
+    usl  = 1, // update stress last
+    usf  = 2  // update stress first
+  };
+
+  // How the GIMP particle domain follows the deformation.
+  enum class DomainUpdate : int
+  {
+    none    = 0, // uGIMP: the domain keeps its initial size
+    det_F   = 1, // cpGIMP: half-lengths scaled by (det F)^(1/dim)
+    stretch = 2  // cpGIMP: half-length i scaled by F_ii (exact for stretch along the axes, not rotation)
+  };
+
+  template <int dim, typename Real>
+  struct StepSettings
+  {
+    UpdateScheme scheme;
+    Real         gravity[dim];   // body acceleration at this step (ramp already applied)
+    Real         damping;        // local damping coefficient D
+    Real         flip_fraction;  // 1: pure FLIP, 0: pure PIC
+    DomainUpdate domain_update;  // uGIMP or cpGIMP variants
+    Real         mass_tolerance; // nodes lighter than this carry no velocity
+  };
+
+  // Per-step reductions over the points: the next time step needs the largest speed,
+  // the time history the power of gravity.
+  template <typename Real>
+  struct StepReduction
+  {
+    Real max_speed;
+    Real gravity_power;
+  };
+
+  // Hooks between a P2G pass and the nodal update, where ranks sum their ghost
+  // contributions (deal.II's compress/update_ghost_values). The core needs none.
+  struct NoGridExchange
+  {
+    template <typename Real>
+    void sum_nodal(Real *const *, int) const
+    {}
+  };
+
+  namespace stages
+  {
+    template <int dim, typename Real, typename Backend>
+    void reset_grid(Backend &backend, const GridView<dim, Real> &g, const bool mass_too)
+    {
+      backend.for_each_node(g.n_nodes, [=] MPM_HOST_DEVICE(const int n) {
+        if (mass_too)
+          g.mass[n] = Real(0);
+        for (int d = 0; d < dim; ++d)
+          {
+            g.momentum[d][n] = Real(0);
+            g.force[d][n]    = Real(0);
+          }
+      });
+    }
+
+    // P2G: nodal mass and momentum, and/or internal (-V sigma . grad N) and gravity forces.
+    template <int dim, typename Shape, typename Real, typename Backend>
+    void particles_to_grid(Backend                          &backend,
+                           const GridView<dim, Real>        &g,
+                           const PointsView<dim, Real>      &p,
+                           const StepSettings<dim, Real>    &s,
+                           const bool                        mass_and_momentum,
+                           const bool                        forces)
+    {
+      backend.scatter_points(p.n_points, [=] MPM_HOST_DEVICE(const int i) {
+        if (p.material[i] < 0)
+          return;
+        Real x[dim], lp[dim], v[dim];
+        for (int d = 0; d < dim; ++d)
+          {
+            x[d]  = p.position[d][i];
+            lp[d] = p.domain_half_length[d][i];
+            v[d]  = p.velocity[d][i];
+          }
+        const Real m = p.mass[i], V = p.volume[i];
+        SymTensor<Real> sigma;
+        for (int c = 0; c < n_voigt; ++c)
+          sigma[c] = p.stress[c][i];
+
+        for_each_stencil_node<dim, Shape>(g, x, lp, [&](const int n, const Real N, const Real *grad) {
+          if (mass_and_momentum)
+            {
+              Backend::add(&g.mass[n], N * m);
+              for (int d = 0; d < dim; ++d)
+                Backend::add(&g.momentum[d][n], N * m * v[d]);
+            }
+          if (forces)
+            for (int d = 0; d < dim; ++d)
+              {
+                Real f_int = Real(0);
+                for (int e = 0; e < dim; ++e)
+                  f_int -= sigma(d, e) * grad[e];
+                Backend::add(&g.force[d][n], V * f_int + N * m * s.gravity[d]);
+              }
+        });
+      });
+    }
+
+    // Grid update: local damping f <- f - D |f| sign(v), boundary masks, explicit
+    // momentum update. Leaves the acceleration in force[] and v^{n+1} in velocity[].
+    template <int dim, typename Real, typename Backend>
+    void update_grid(Backend &backend, const GridView<dim, Real> &g, const StepSettings<dim, Real> &s,
+                     const Real dt)
+    {
+      backend.for_each_node(g.n_nodes, [=] MPM_HOST_DEVICE(const int n) {
+        const Real m = g.mass[n];
+        for (int d = 0; d < dim; ++d)
+          {
+            const bool fixed = (g.fixed_components[n] >> d) & 1u;
+            if (m <= s.mass_tolerance || fixed)
+              {
+                g.momentum[d][n] = g.force[d][n] = g.velocity[d][n] = Real(0);
+                continue;
+              }
+            Real       f = g.force[d][n];
+            const Real v = g.momentum[d][n] / m;
+            if (v != Real(0))
+              f -= s.damping * std::fabs(f) * (v > Real(0) ? Real(1) : Real(-1));
+            const Real p_new = g.momentum[d][n] + dt * f;
+            g.momentum[d][n] = p_new;
+            g.velocity[d][n] = p_new / m;
+            g.force[d][n]    = f / m;
+          }
+      });
+    }
+
+    // Nodal velocity from nodal momentum, boundary masks re-imposed.
+    template <int dim, typename Real, typename Backend>
+    void velocity_from_momentum(Backend &backend, const GridView<dim, Real> &g, const Real mass_tolerance)
+    {
+      backend.for_each_node(g.n_nodes, [=] MPM_HOST_DEVICE(const int n) {
+        const Real m = g.mass[n];
+        for (int d = 0; d < dim; ++d)
+          {
+            const bool fixed = (g.fixed_components[n] >> d) & 1u;
+            g.velocity[d][n] = (m <= mass_tolerance || fixed) ? Real(0) : g.momentum[d][n] / m;
+          }
+      });
+    }
+
+    // G2P velocity: FLIP v_p += dt sum N a_i, blended with PIC v_p = sum N v_i^{n+1}.
+    template <int dim, typename Shape, typename Real, typename Backend>
+    void grid_to_particle_velocity(Backend &backend, const GridView<dim, Real> &g,
+                                   const PointsView<dim, Real> &p, const StepSettings<dim, Real> &s,
+                                   const Real dt)
+    {
+      backend.gather_points(p.n_points, [=] MPM_HOST_DEVICE(const int i) {
+        if (p.material[i] < 0)
+          return;
+        Real x[dim], lp[dim], a[dim] = {}, v_pic[dim] = {};
+        for (int d = 0; d < dim; ++d)
+          {
+            x[d]  = p.position[d][i];
+            lp[d] = p.domain_half_length[d][i];
+          }
+        for_each_stencil_node<dim, Shape>(g, x, lp, [&](const int n, const Real N, const Real *) {
+          for (int d = 0; d < dim; ++d)
+            {
+              a[d] += N * g.force[d][n];
+              v_pic[d] += N * g.velocity[d][n];
+            }
+        });
+        for (int d = 0; d < dim; ++d)
+          {
+            const Real v_flip = p.velocity[d][i] + dt * a[d];
+            p.velocity[d][i]  = s.flip_fraction * v_flip + (Real(1) - s.flip_fraction) * v_pic[d];
+          }
+      });
+    }
+
+    // MUSL remap: nodal momentum rebuilt from the updated point velocities.
+    template <int dim, typename Shape, typename Real, typename Backend>
+    void remap_momentum(Backend &backend, const GridView<dim, Real> &g, const PointsView<dim, Real> &p)
+    {
+      backend.for_each_node(g.n_nodes, [=] MPM_HOST_DEVICE(const int n) {
+        for (int d = 0; d < dim; ++d)
+          g.momentum[d][n] = Real(0);
+      });
+      backend.scatter_points(p.n_points, [=] MPM_HOST_DEVICE(const int i) {
+        if (p.material[i] < 0)
+          return;
+        Real x[dim], lp[dim], mv[dim];
+        for (int d = 0; d < dim; ++d)
+          {
+            x[d]  = p.position[d][i];
+            lp[d] = p.domain_half_length[d][i];
+            mv[d] = p.mass[i] * p.velocity[d][i];
+          }
+        for_each_stencil_node<dim, Shape>(g, x, lp, [&](const int n, const Real N, const Real *) {
+          for (int d = 0; d < dim; ++d)
+            Backend::add(&g.momentum[d][n], N * mv[d]);
+        });
+      });
+    }
+
+    // G2P kinematics from the nodal velocity field, then per point: position,
+    // strain and spin increments, volume and particle domain, constitutive update.
+    // A point whose centre leaves the grid is marked removed (material = -1).
+    // The particle domain is rescaled only in the pass that moves the points, so that
+    // every transfer of one step uses the same stencil (USF deforms before it moves).
+    template <int dim, typename Shape, typename Real, typename Backend>
+    void grid_to_particle_kinematics(Backend &backend, const GridView<dim, Real> &g,
+                                     const PointsView<dim, Real> &p,
+                                     const MaterialParameters<Real> *materials,
+                                     const StepSettings<dim, Real> &s, const Real dt,
+                                     const bool move_points, const bool deform_points)
+    {
+      backend.gather_points(p.n_points, [=] MPM_HOST_DEVICE(const int i) {
+        if (p.material[i] < 0)
+          return;
+        Real x[dim], lp[dim], dx[dim] = {};
+        Mat3<Real> L = Mat3<Real>::zero(); // velocity gradient; plane strain keeps row/column z zero
+        for (int d = 0; d < dim; ++d)
+          {
+            x[d]  = p.position[d][i];
+            lp[d] = p.domain_half_length[d][i];
+          }
+        for_each_stencil_node<dim, Shape>(g, x, lp, [&](const int n, const Real N, const Real *grad) {
+          for (int d = 0; d < dim; ++d)
+            {
+              const Real v = g.velocity[d][n];
+              dx[d] += N * v;
+              for (int e = 0; e < dim; ++e)
+                L.a[d][e] += v * grad[e];
+            }
+        });
+
+        if (deform_points)
+          {
+            Mat3<Real> dF = Mat3<Real>::identity(), dW;
+            for (int a = 0; a < 3; ++a)
+              for (int b = 0; b < 3; ++b)
+                {
+                  dF.a[a][b] += dt * L.a[a][b];
+                  dW.a[a][b] = Real(0.5) * dt * (L.a[a][b] - L.a[b][a]);
+                }
+            Mat3<Real> Ldt;
+            for (int a = 0; a < 3; ++a)
+              for (int b = 0; b < 3; ++b)
+                Ldt.a[a][b] = dt * L.a[a][b];
+            const SymTensor<Real> d_eps = symmetric_part(Ldt);
+
+            // F <- (I + L dt) F; the volume follows det F.
+            Mat3<Real> F = Mat3<Real>::identity();
+            for (int a = 0; a < dim; ++a)
+              for (int b = 0; b < dim; ++b)
+                F.a[a][b] = p.deformation_gradient[a * dim + b][i];
+            F = multiply(dF, F);
+            for (int a = 0; a < dim; ++a)
+              for (int b = 0; b < dim; ++b)
+                p.deformation_gradient[a * dim + b][i] = F.a[a][b];
+            p.volume[i] = p.initial_volume[i] * determinant(F);
+            MaterialPointState<Real> state;
+            for (int c = 0; c < n_voigt; ++c)
+              state.stress[c] = p.stress[c][i];
+            state.plastic_strain = p.plastic_strain[i];
+            update_stress(materials[p.material[i]], d_eps, dW, state);
+            for (int c = 0; c < n_voigt; ++c)
+              {
+                p.stress[c][i] = state.stress[c];
+                p.strain[c][i] += d_eps[c];
+              }
+            p.plastic_strain[i] = state.plastic_strain;
+          }
+
+        if (s.domain_update != DomainUpdate::none && move_points)
+          {
+            const Real J     = p.volume[i] / p.initial_volume[i];
+            const Real iso   = dim == 2 ? std::sqrt(J) : std::cbrt(J);
+            for (int d = 0; d < dim; ++d)
+              {
+                const Real scale = s.domain_update == DomainUpdate::det_F ?
+                                     iso :
+                                     std::fabs(p.deformation_gradient[d * dim + d][i]);
+                // GIMP weights are valid up to half a cell.
+                const Real l = p.initial_domain_half_length[d][i] * scale;
+                p.domain_half_length[d][i] = l < Real(0.5) * g.h ? l : Real(0.5) * g.h;
+              }
+          }
+
+        if (move_points)
+          {
+            bool inside = true;
+            for (int d = 0; d < dim; ++d)
+              {
+                const Real xn      = x[d] + dt * dx[d];
+                p.position[d][i]   = xn;
+                const Real s_local = (xn - g.origin[d]) / g.h;
+                // Also catches NaN, which compares false.
+                if (!(s_local >= Real(0) && s_local <= Real(g.n_cells[d])))
+                  inside = false;
+              }
+            if (!inside)
+              p.material[i] = -1;
+          }
+      });
+    }
+
+    template <int dim, typename Real, typename Backend>
+    StepReduction<Real> reduce_step(Backend &backend, const PointsView<dim, Real> &p,
+                                    const StepSettings<dim, Real> &s)
+    {
+      StepReduction<Real> init{Real(0), Real(0)};
+      return backend.reduce_points(
+        p.n_points, init,
+        [=] MPM_HOST_DEVICE(const int i) {
+          StepReduction<Real> r{Real(0), Real(0)};
+          if (p.material[i] < 0)
+            return r;
+          Real v2 = Real(0);
+          for (int d = 0; d < dim; ++d)
+            {
+              const Real v = p.velocity[d][i];
+              v2 += v * v;
+              r.gravity_power += p.mass[i] * s.gravity[d] * v;
+            }
+          r.max_speed = std::sqrt(v2);
+          return r;
+        },
+        [] MPM_HOST_DEVICE(const StepReduction<Real> &a, const StepReduction<Real> &b) {
+          return StepReduction<Real>{a.max_speed > b.max_speed ? a.max_speed : b.max_speed,
+                                     a.gravity_power + b.gravity_power};
+        });
+    }
+  } // namespace stages
+
+  // One step of the chosen scheme. Returns the reductions needed for the next time
+  // step and for the time history.
+  template <int dim, typename Shape, typename Real, typename Backend, typename Exchange = NoGridExchange>
+  StepReduction<Real> explicit_step(Backend &backend, const GridView<dim, Real> &g,
+                                    const PointsView<dim, Real> &p,
+                                    const MaterialParameters<Real> *materials,
+                                    const StepSettings<dim, Real> &s, const Real dt,
+                                    const Exchange &exchange = Exchange())
+  {
+    using namespace stages;
+    Real *mass_and_momentum[dim + 1], *momentum[dim], *forces[dim];
+    mass_and_momentum[0] = g.mass;
+    for (int d = 0; d < dim; ++d)
+      {
+        mass_and_momentum[d + 1] = momentum[d] = g.momentum[d];
+        forces[d]                              = g.force[d];
+      }
+
+    switch (s.scheme)
+      {
+        case UpdateScheme::musl:
+          reset_grid(backend, g, true);
+          particles_to_grid<dim, Shape>(backend, g, p, s, true, true);
+          exchange.sum_nodal(mass_and_momentum, dim + 1);
+          exchange.sum_nodal(forces, dim);
+          update_grid(backend, g, s, dt);
+          grid_to_particle_velocity<dim, Shape>(backend, g, p, s, dt);
+          remap_momentum<dim, Shape>(backend, g, p);
+          exchange.sum_nodal(momentum, dim);
+          velocity_from_momentum(backend, g, s.mass_tolerance);
+          grid_to_particle_kinematics<dim, Shape>(backend, g, p, materials, s, dt, true, true);
+          break;
+
+        case UpdateScheme::usl:
+          reset_grid(backend, g, true);
+          particles_to_grid<dim, Shape>(backend, g, p, s, true, true);
+          exchange.sum_nodal(mass_and_momentum, dim + 1);
+          exchange.sum_nodal(forces, dim);
+          update_grid(backend, g, s, dt);
+          grid_to_particle_velocity<dim, Shape>(backend, g, p, s, dt);
+          grid_to_particle_kinematics<dim, Shape>(backend, g, p, materials, s, dt, true, true);
+          break;
+
+        case UpdateScheme::usf:
+          reset_grid(backend, g, true);
+          particles_to_grid<dim, Shape>(backend, g, p, s, true, false);
+          exchange.sum_nodal(mass_and_momentum, dim + 1);
+          velocity_from_momentum(backend, g, s.mass_tolerance);
+          grid_to_particle_kinematics<dim, Shape>(backend, g, p, materials, s, dt, false, true);
+          particles_to_grid<dim, Shape>(backend, g, p, s, false, true);
+          exchange.sum_nodal(forces, dim);
+          update_grid(backend, g, s, dt);
+          grid_to_particle_velocity<dim, Shape>(backend, g, p, s, dt);
+          grid_to_particle_kinematics<dim, Shape>(backend, g, p, materials, s, dt, true, false);
+          break;
+      }
+    return reduce_step(backend, p, s);
+  }
+
+  // Dispatch on the shape function chosen at run time.
+  template <int dim, typename Real, typename Backend, typename Exchange = NoGridExchange>
+  StepReduction<Real> explicit_step(Backend &backend, const ShapeFunction shape,
+                                    const GridView<dim, Real> &g, const PointsView<dim, Real> &p,
+                                    const MaterialParameters<Real> *materials,
+                                    const StepSettings<dim, Real> &s, const Real dt,
+                                    const Exchange &exchange = Exchange())
+  {
+    if (shape == ShapeFunction::gimp)
+      return explicit_step<dim, GimpShape>(backend, g, p, materials, s, dt, exchange);
+    return explicit_step<dim, LinearShape>(backend, g, p, materials, s, dt, exchange);
+  }
+} // namespace mpm

@@ -1,0 +1,64 @@
+// Plain views (pointers + sizes) of the grid and point arrays the step works on.
+// They own nothing: the deal.II layer or a standalone driver allocates the memory
+// (host or device) and fills the views. Arrays are structure-of-arrays so that
+// consecutive points / nodes are consecutive in memory on every backend.
+#pragma once
+
+#include <mpm/core/config.h>
+
+#include <cstdint>
+
+namespace mpm
+{
+  // Uniform background lattice; nodes are reached through a lookup so that the
+  // node numbering can be deal.II's locally relevant DoF space (and later sparse).
+  template <int dim, typename Real>
+  struct GridView
+  {
+    Real origin[dim];           // lower corner of the grid
+    Real h;                     // cell size, equal in every direction
+    int  n_cells[dim];          // cells per direction
+    const int *lattice_to_node; // lattice index -> local node index, -1 if absent
+    int        n_nodes;         // local nodes (length of the arrays below)
+
+    Real *mass;
+    Real *momentum[dim];
+    Real *force[dim];    // force, after the grid update: acceleration
+    Real *velocity[dim]; // nodal velocity used by G2P kinematics
+    const std::uint8_t *fixed_components; // bit d set: velocity component d is prescribed zero
+
+    MPM_HOST_DEVICE int n_lattice_nodes(const int d) const { return n_cells[d] + 1; }
+
+    // Local node index of lattice node (i,j,k), or -1 outside the lattice.
+    MPM_HOST_DEVICE int node(const int idx[dim]) const
+    {
+      long lattice = 0;
+      for (int d = dim - 1; d >= 0; --d)
+        {
+          if (idx[d] < 0 || idx[d] > n_cells[d])
+            return -1;
+          lattice = lattice * (n_cells[d] + 1) + idx[d];
+        }
+      return lattice_to_node[lattice];
+    }
+  };
+
+  // Material point arrays. material[p] < 0 marks a point that left the grid.
+  template <int dim, typename Real>
+  struct PointsView
+  {
+    int   n_points;
+    Real *position[dim];
+    Real *velocity[dim];
+    Real *mass;
+    Real *volume;
+    Real *initial_volume;
+    Real *stress[n_voigt];
+    Real *strain[n_voigt];  // accumulated small-strain measure, for output
+    Real *deformation_gradient[dim * dim]; // F, row-major; plane strain keeps F_zz = 1
+    Real *domain_half_length[dim];         // GIMP particle half-lengths (current)
+    Real *initial_domain_half_length[dim]; // at the reference configuration
+    Real *plastic_strain;                  // accumulated equivalent plastic strain
+    int  *material;
+  };
+} // namespace mpm

@@ -1,0 +1,98 @@
+// Partition of unity, zero gradient sum, and gradients equal to the derivative of the
+// weights (finite differences), for linear and GIMP stencils at random points, 2D and 3D.
+#include <mpm/core/host_storage.h>
+#include <mpm/core/interpolation.h>
+#include <mpm/core/shape_functions.h>
+
+#include "check.h"
+
+#include <random>
+#include <vector>
+
+using namespace mpm;
+
+template <int dim, typename Shape>
+void check_family(const char *name, std::mt19937 &rng)
+{
+  HostGrid<dim, double> grid;
+  const double          lower[3] = {-1.0, 0.5, 2.0};
+  const int             cells[3] = {7, 5, 6};
+  grid.make_dense(lower, 0.37, cells);
+  const GridView<dim, double> g = grid.view();
+
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  double worst_sum = 0, worst_grad = 0, worst_fd = 0;
+  for (int trial = 0; trial < 2000; ++trial)
+    {
+      double x[dim], lp[dim];
+      for (int d = 0; d < dim; ++d)
+        {
+          lp[d] = (0.01 + 0.49 * u(rng)) * g.h;
+          // keep the particle domain inside the grid, so no weight falls outside it
+          x[d] = g.origin[d] + lp[d] + u(rng) * (g.n_cells[d] * g.h - 2 * lp[d]);
+        }
+      double sum = 0, grad_sum[dim] = {};
+      std::vector<double> weight(g.n_nodes, 0.0), gradient(g.n_nodes * dim, 0.0);
+      for_each_stencil_node<dim, Shape>(g, x, lp, [&](int n, double N, const double *grad) {
+        sum += N;
+        weight[n] = N;
+        for (int d = 0; d < dim; ++d)
+          {
+            grad_sum[d] += grad[d];
+            gradient[n * dim + d] = grad[d];
+          }
+        mpm_test::check(N >= -1e-15, "weights are non-negative", N, 0);
+      });
+      worst_sum = std::max(worst_sum, std::abs(sum - 1.0));
+      for (int d = 0; d < dim; ++d)
+        worst_grad = std::max(worst_grad, std::abs(grad_sum[d]) * g.h);
+
+      // central differences of the weights along each direction
+      const double eps = 1e-6 * g.h;
+      for (int d = 0; d < dim; ++d)
+        {
+          double xp[dim], xm[dim];
+          for (int e = 0; e < dim; ++e)
+            xp[e] = xm[e] = x[e];
+          xp[d] += eps;
+          xm[d] -= eps;
+          std::vector<double> wp(g.n_nodes, 0.0), wm(g.n_nodes, 0.0);
+          for_each_stencil_node<dim, Shape>(g, xp, lp, [&](int n, double N, const double *) { wp[n] = N; });
+          for_each_stencil_node<dim, Shape>(g, xm, lp, [&](int n, double N, const double *) { wm[n] = N; });
+          for (int n = 0; n < g.n_nodes; ++n)
+            {
+              const double fd = (wp[n] - wm[n]) / (2 * eps);
+              // linear weights have kinks at nodes: skip points within eps of one
+              if (std::abs(fd - gradient[n * dim + d]) * g.h > 1e-4)
+                {
+                  const double s = (x[d] - g.origin[d]) / g.h;
+                  if (std::abs(s - std::round(s)) * g.h < 10 * eps)
+                    continue;
+                }
+              worst_fd = std::max(worst_fd, std::abs(fd - gradient[n * dim + d]) * g.h);
+            }
+        }
+    }
+  std::printf("%s %dD: max |sum N - 1| = %.2e, max |sum grad N| h = %.2e, max gradient vs FD = %.2e\n", name,
+              dim, worst_sum, worst_grad, worst_fd);
+  mpm_test::check_below(worst_sum, 1e-14, "partition of unity");
+  mpm_test::check_below(worst_grad, 1e-13, "gradients sum to zero");
+  mpm_test::check_below(worst_fd, 1e-6, "gradient equals derivative of the weight");
+}
+
+int main()
+{
+  std::mt19937 rng(42);
+  check_family<2, LinearShape>("linear", rng);
+  check_family<3, LinearShape>("linear", rng);
+  check_family<2, GimpShape>("GIMP", rng);
+  check_family<3, GimpShape>("GIMP", rng);
+
+  // GIMP tends to the linear hat as the particle domain shrinks.
+  double w_lin[2], dw_lin[2], w_g[3], dw_g[3];
+  int    f_lin, f_g;
+  LinearShape::weights_1d(3.3, 0.0, f_lin, w_lin, dw_lin);
+  GimpShape::weights_1d(3.3, 1e-9, f_g, w_g, dw_g);
+  mpm_test::check_below(std::abs(w_g[f_lin - f_g] - w_lin[0]), 1e-8, "GIMP -> linear for lp -> 0");
+  return mpm_test::finish("test_shape_functions");
+}
