@@ -1,0 +1,99 @@
+// Strength parameters shared by the frictional plasticity models (Drucker-Prager,
+// Mohr-Coulomb) and their softening with the accumulated equivalent plastic strain
+// eps_p (see doc/theory-plasticity.md):
+//   c(eps_p)   = max(c_res, c_peak - H eps_p)                         (linear cohesion softening)
+//   phi(eps_p) = phi_peak + (phi_res - phi_peak) min(1, eps_p / eps_phi)  (optional friction softening)
+//   psi        = min(psi, phi(eps_p))                                  (dilatancy never exceeds friction)
+// Angles are in radians here; the prm layer converts from degrees.
+#pragma once
+
+#include <mpm/core/config.h>
+
+#include <cmath>
+
+namespace mpm
+{
+  template <typename Real>
+  struct SofteningStrength
+  {
+    Real cohesion                  = Real(0); // c_peak [Pa]
+    Real residual_cohesion         = Real(0); // c_res [Pa], <= c_peak
+    Real softening_modulus         = Real(0); // H [Pa per unit eps_p], >= 0; 0: no cohesion softening
+    Real friction_angle            = Real(0); // phi_peak [rad]
+    Real residual_friction_angle   = Real(0); // phi_res [rad]; equal to phi_peak: no friction softening
+    Real friction_softening_strain = Real(0); // eps_phi where phi reaches phi_res; <= 0: the strain at which
+                                              // c reaches c_res, (c_peak - c_res)/H; no softening if neither
+    Real dilatancy_angle           = Real(0); // psi [rad], 0 <= psi <= phi
+  };
+
+  // The strength at one plastic strain, as the return mappings use it.
+  template <typename Real>
+  struct CurrentStrength
+  {
+    Real cohesion;
+    Real sin_phi, cos_phi;
+    Real sin_psi;
+  };
+
+  template <typename Real>
+  MPM_HOST_DEVICE inline Real softened_cohesion(const SofteningStrength<Real> &s, const Real eps_p)
+  {
+    const Real c = s.cohesion - s.softening_modulus * eps_p;
+    return c > s.residual_cohesion ? c : s.residual_cohesion;
+  }
+
+  template <typename Real>
+  MPM_HOST_DEVICE inline Real softened_friction_angle(const SofteningStrength<Real> &s, const Real eps_p)
+  {
+    Real eps_phi = s.friction_softening_strain;
+    if (!(eps_phi > Real(0)) && s.softening_modulus > Real(0) && s.cohesion > s.residual_cohesion)
+      eps_phi = (s.cohesion - s.residual_cohesion) / s.softening_modulus;
+    if (!(eps_phi > Real(0)))
+      return s.friction_angle;
+    const Real xi = eps_p < eps_phi ? eps_p / eps_phi : Real(1);
+    return s.friction_angle + (s.residual_friction_angle - s.friction_angle) * xi;
+  }
+
+  template <typename Real>
+  MPM_HOST_DEVICE inline CurrentStrength<Real> current_strength(const SofteningStrength<Real> &s, const Real eps_p)
+  {
+    CurrentStrength<Real> r;
+    const Real phi = softened_friction_angle(s, eps_p);
+    const Real psi = s.dilatancy_angle < phi ? s.dilatancy_angle : phi;
+    r.cohesion     = softened_cohesion(s, eps_p);
+    r.sin_phi      = std::sin(phi);
+    r.cos_phi      = std::cos(phi);
+    r.sin_psi      = std::sin(psi);
+    return r;
+  }
+
+  // What a return mapping did; the tests read it, the step ignores it.
+  enum class ReturnMode : int
+  {
+    elastic = 0,
+    shear,          // DP cone / MC plane
+    tension,        // DP tension cut-off plane
+    corner,         // DP: cone and tension plane together
+    edge_extension, // MC: sigma_2 = sigma_3 edge (triaxial extension meridian), tension positive
+    edge_compression, // MC: sigma_1 = sigma_2 edge (triaxial compression meridian), tension positive
+    apex            // MC apex, sigma = c cot(phi) 1
+  };
+
+  template <typename Real>
+  struct ReturnResult
+  {
+    ReturnMode mode;
+    Real       multiplier[2];     // plastic multipliers of the active surfaces (see each model)
+    Real       d_plastic_strain;  // increment of eps_p = sqrt(2/3 d_eps^p : d_eps^p)
+  };
+
+  template <typename Real>
+  MPM_HOST_DEVICE inline ReturnResult<Real> elastic_return()
+  {
+    ReturnResult<Real> r;
+    r.mode          = ReturnMode::elastic;
+    r.multiplier[0] = r.multiplier[1] = Real(0);
+    r.d_plastic_strain                = Real(0);
+    return r;
+  }
+} // namespace mpm
