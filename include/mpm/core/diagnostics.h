@@ -1,0 +1,62 @@
+// Totals over the material points for the time history: mass, kinetic energy,
+// linear momentum, number of points and bounding box of the material.
+#pragma once
+
+#include <mpm/core/views.h>
+
+namespace mpm
+{
+  template <int dim, typename Real>
+  struct PointTotals
+  {
+    Real mass;
+    Real kinetic_energy;
+    Real momentum[dim];
+    Real lower[dim], upper[dim];
+    long n_points;
+  };
+
+  template <int dim, typename Real, typename Backend>
+  PointTotals<dim, Real> point_totals(Backend &backend, const PointsView<dim, Real> &p)
+  {
+    PointTotals<dim, Real> identity;
+    identity.mass = identity.kinetic_energy = Real(0);
+    identity.n_points                       = 0;
+    for (int d = 0; d < dim; ++d)
+      {
+        identity.momentum[d] = Real(0);
+        identity.lower[d]    = Real(1e300);
+        identity.upper[d]    = Real(-1e300);
+      }
+    return backend.reduce_points(
+      p.n_points, identity,
+      [=] MPM_HOST_DEVICE(const int i) {
+        PointTotals<dim, Real> t = identity;
+        if (p.material[i] < 0)
+          return t;
+        t.mass     = p.mass[i];
+        t.n_points = 1;
+        for (int d = 0; d < dim; ++d)
+          {
+            const Real v = p.velocity[d][i];
+            t.kinetic_energy += Real(0.5) * p.mass[i] * v * v;
+            t.momentum[d] = p.mass[i] * v;
+            t.lower[d] = t.upper[d] = p.position[d][i];
+          }
+        return t;
+      },
+      [] MPM_HOST_DEVICE(const PointTotals<dim, Real> &a, const PointTotals<dim, Real> &b) {
+        PointTotals<dim, Real> r;
+        r.mass           = a.mass + b.mass;
+        r.kinetic_energy = a.kinetic_energy + b.kinetic_energy;
+        r.n_points       = a.n_points + b.n_points;
+        for (int d = 0; d < dim; ++d)
+          {
+            r.momentum[d] = a.momentum[d] + b.momentum[d];
+            r.lower[d]    = a.lower[d] < b.lower[d] ? a.lower[d] : b.lower[d];
+            r.upper[d]    = a.upper[d] > b.upper[d] ? a.upper[d] : b.upper[d];
+          }
+        return r;
+      });
+  }
+} // namespace mpm

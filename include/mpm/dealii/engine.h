@@ -1,0 +1,33 @@
+// Where the MPM step runs. The simulator hands points over at the start and takes
+// them back only when deal.II must see them (output, end of run); in between, the
+// engine keeps them in the backend's arrays. CPU today; the CUDA engine implements
+// the same interface over device arrays.
+#pragma once
+
+#include <mpm/core/diagnostics.h>
+#include <mpm/core/step.h>
+#include <mpm/dealii/material_points.h>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace mpm
+{
+  template <int dim>
+  class Engine
+  {
+  public:
+    virtual ~Engine() = default;
+    virtual void                    load(const MaterialPoints<dim> &points)           = 0;
+    virtual unsigned int            store(MaterialPoints<dim> &points)                = 0;
+    virtual StepReduction<double>   step(const StepSettings<dim, double> &s, double dt) = 0;
+    virtual PointTotals<dim, double> totals()                                         = 0;
+  };
+
+  // Throws naming Backend/Backend if the requested backend is not available.
+  template <int dim>
+  std::unique_ptr<Engine<dim>> make_engine(const std::string &backend, BackgroundGrid<dim> &grid,
+                                           const std::vector<MaterialParameters<double>> &materials,
+                                           ShapeFunction shape);
+} // namespace mpm

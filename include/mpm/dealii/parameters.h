@@ -1,0 +1,93 @@
+// Run-time parameters of a dealii-mpm run, read from a deal.II parameter file.
+// Every entry is declared with a pattern and a documentation string in
+// parameters.cc; the executable prints them all with --print-parameters.
+#pragma once
+
+#include <mpm/core/material/material.h>
+#include <mpm/core/shape_functions.h>
+#include <mpm/core/step.h>
+
+#include <deal.II/base/parameter_handler.h>
+
+#include <array>
+#include <string>
+#include <vector>
+
+namespace mpm
+{
+  enum class BoundaryType
+  {
+    free,      // no constraint
+    no_slip,   // every velocity component zero
+    free_slip  // normal velocity component zero (roller)
+  };
+
+  struct BodyParameters
+  {
+    std::string                        shape; // box | polygon
+    std::vector<double>                lower, upper;
+    std::vector<std::array<double, 2>> polygon; // (horizontal, vertical) pairs
+    unsigned int                       points_per_direction;
+    double                             density;
+    std::vector<double>                velocity;
+    std::string                        material;
+    std::string                        initial_stress; // none | geostatic
+    double                             k0;
+  };
+
+  struct Parameters
+  {
+    unsigned int dim = 2;
+
+    // Grid
+    std::vector<double> lower, upper;
+    double              cell_size;
+    std::array<BoundaryType, 6> boundary{}; // by boundary id: x min, x max, y min, y max, z min, z max
+
+    // Solver
+    double       end_time;
+    UpdateScheme scheme;
+    ShapeFunction shape_function;
+    DomainUpdate domain_update;
+    bool         adaptive_time_step;
+    double       cfl;
+    double       fixed_time_step;
+    double       damping;
+    double       flip_fraction;
+    std::vector<double> gravity;
+    double       gravity_ramp_time;
+    unsigned int max_steps;
+
+    // Materials, in the order of their names; bodies refer to them by index.
+    std::vector<std::string>                material_names;
+    std::vector<std::string>                material_models;
+    std::vector<MaterialParameters<double>> materials;
+    std::vector<BodyParameters>             bodies;
+    std::vector<unsigned int>               body_material; // index into materials
+
+    // Output
+    std::string  output_directory;
+    double       output_interval;
+    bool         write_grid_fields;
+    bool         write_particles;
+    unsigned int history_every;
+    double       progress_interval;
+
+    // Backend
+    std::string backend;
+
+    // Declares every entry for a given dimension, number of bodies and material names.
+    static void declare(dealii::ParameterHandler &prm, unsigned int dim, unsigned int n_bodies,
+                        const std::vector<std::string> &material_names);
+    // Reads declared entries and checks the combinations a pattern cannot express.
+    void parse(dealii::ParameterHandler &prm);
+  };
+
+  // Two-pass read of a parameter file: the first pass finds the dimension, the number
+  // of bodies and the material names, the second declares and reads everything,
+  // rejecting unknown entries. Throws with a message naming the offending entry.
+  Parameters read_parameters(const std::string &filename);
+
+  // Prints every entry with its default and documentation (for --print-parameters).
+  void print_parameters(std::ostream &out, unsigned int dim, const std::string &style);
+} // namespace mpm

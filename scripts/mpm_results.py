@@ -1,0 +1,44 @@
+"""Read dealii-mpm output: the time series of particles (.pvd -> .pvtu -> .vtu pieces)
+and the time history (history.csv). Needs Debian's python3-numpy and python3-meshio."""
+import csv
+import os
+import xml.etree.ElementTree as ET
+
+import meshio
+import numpy as np
+
+
+def pvd_records(output_dir, name="particles"):
+    """[(time, pvtu file name)] in the order written."""
+    root = ET.parse(os.path.join(output_dir, name + ".pvd")).getroot()
+    return [(float(d.get("timestep")), d.get("file")) for d in root.iter("DataSet")]
+
+
+def read_pvtu(output_dir, pvtu):
+    """Points and point data of all pieces of one .pvtu file, merged."""
+    root = ET.parse(os.path.join(output_dir, pvtu)).getroot()
+    pieces = [p.get("Source") for p in root.iter("Piece")]
+    points, data = [], {}
+    for piece in pieces:
+        m = meshio.read(os.path.join(output_dir, piece))
+        points.append(m.points)
+        for key, value in m.point_data.items():
+            data.setdefault(key, []).append(np.asarray(value, dtype=float))
+    result = {key: np.concatenate(v) for key, v in data.items()}
+    result["position"] = np.concatenate(points).astype(float)
+    return result
+
+
+def particles_at(output_dir, index=-1):
+    """Particle data of output number `index` (default: the last); also its time."""
+    time, pvtu = pvd_records(output_dir)[index]
+    data = read_pvtu(output_dir, pvtu)
+    data["time"] = time
+    return data
+
+
+def history(output_dir):
+    """The time history as a dict of numpy arrays, one per column."""
+    with open(os.path.join(output_dir, "history.csv")) as f:
+        rows = list(csv.DictReader(f))
+    return {key: np.array([float(r[key]) for r in rows]) for key in rows[0]}

@@ -1,0 +1,64 @@
+#include <mpm/core/backend/cpu_backend.h>
+#include <mpm/dealii/engine.h>
+
+#include <deal.II/base/exceptions.h>
+
+namespace mpm
+{
+  namespace
+  {
+    template <int dim>
+    class CpuEngine : public Engine<dim>
+    {
+    public:
+      CpuEngine(BackgroundGrid<dim> &grid, const std::vector<MaterialParameters<double>> &materials,
+                const ShapeFunction shape)
+        : grid(grid)
+        , materials(materials)
+        , shape(shape)
+      {}
+
+      void load(const MaterialPoints<dim> &p) override { p.copy_to(points); }
+
+      unsigned int store(MaterialPoints<dim> &p) override
+      {
+        const unsigned int removed = p.copy_from(points);
+        p.copy_to(points); // the handler re-sorted them: take the new order
+        return removed;
+      }
+
+      StepReduction<double> step(const StepSettings<dim, double> &s, const double dt) override
+      {
+        return explicit_step<dim>(backend, shape, grid.view(), points.view(), materials.data(), s, dt,
+                                  grid.exchange());
+      }
+
+      PointTotals<dim, double> totals() override { return point_totals<dim>(backend, points.view()); }
+
+    private:
+      BackgroundGrid<dim>                    &grid;
+      std::vector<MaterialParameters<double>> materials;
+      ShapeFunction                           shape;
+      CpuBackend                              backend;
+      HostPoints<dim, double>                 points;
+    };
+  } // namespace
+
+  template <int dim>
+  std::unique_ptr<Engine<dim>> make_engine(const std::string &backend, BackgroundGrid<dim> &grid,
+                                           const std::vector<MaterialParameters<double>> &materials,
+                                           const ShapeFunction shape)
+  {
+    if (backend == "cpu")
+      return std::make_unique<CpuEngine<dim>>(grid, materials, shape);
+    AssertThrow(false, dealii::ExcMessage("Parameter 'Backend/Backend': '" + backend +
+                                          "' is not available in this build (allowed here: cpu). Build with "
+                                          "-DMPM_WITH_CUDA=ON for cuda."));
+    return nullptr;
+  }
+
+  template std::unique_ptr<Engine<2>> make_engine(const std::string &, BackgroundGrid<2> &,
+                                                  const std::vector<MaterialParameters<double>> &, ShapeFunction);
+  template std::unique_ptr<Engine<3>> make_engine(const std::string &, BackgroundGrid<3> &,
+                                                  const std::vector<MaterialParameters<double>> &, ShapeFunction);
+} // namespace mpm

@@ -1,0 +1,76 @@
+// dealii-mpm: explicit material point method for large deformation of soils.
+//   dealii-mpm scene.prm              run a scene
+//   dealii-mpm --print-parameters [2|3] [prm|description|json]
+//   dealii-mpm --help
+#include <mpm/dealii/parameters.h>
+#include <mpm/dealii/simulator.h>
+
+#include <deal.II/base/mpi.h>
+
+#include <iostream>
+#include <string>
+
+namespace
+{
+  void print_help(std::ostream &out)
+  {
+    out << "dealii-mpm: explicit material point method (MUSL/USL/USF, linear or GIMP shape functions)\n"
+           "on a deal.II background grid, for elasto-plastic large deformation of soils.\n\n"
+           "Usage:\n"
+           "  dealii-mpm scene.prm                 run the scene described by a parameter file\n"
+           "  mpirun -np N dealii-mpm scene.prm    the same on N MPI ranks\n"
+           "  dealii-mpm --print-parameters [2|3] [prm|description|json]\n"
+           "                                       print every parameter with its default and documentation\n"
+           "  dealii-mpm --help                    this text\n";
+  }
+} // namespace
+
+int main(int argc, char **argv)
+{
+  dealii::Utilities::MPI::MPI_InitFinalize mpi(argc, argv, dealii::numbers::invalid_unsigned_int);
+  const bool root = dealii::Utilities::MPI::this_mpi_process(MPI_COMM_WORLD) == 0;
+  try
+    {
+      const std::string first = argc > 1 ? argv[1] : "";
+      if (first == "--help" || first == "-h")
+        {
+          if (root)
+            print_help(std::cout);
+          return 0;
+        }
+      if (first == "--print-parameters")
+        {
+          const unsigned int dim = argc > 2 ? std::stoi(argv[2]) : 2;
+          if (dim != 2 && dim != 3)
+            throw std::runtime_error("--print-parameters: the dimension must be 2 or 3.");
+          if (root)
+            mpm::print_parameters(std::cout, dim, argc > 3 ? argv[3] : "prm");
+          return 0;
+        }
+      if (argc != 2 || first.empty() || first[0] == '-')
+        {
+          if (root)
+            print_help(std::cerr);
+          return 2;
+        }
+      const mpm::Parameters parameters = mpm::read_parameters(first);
+      mpm::run_simulation(parameters, MPI_COMM_WORLD);
+    }
+  catch (const dealii::ExceptionBase &e)
+    {
+      if (root)
+        {
+          std::cerr << "\ndealii-mpm: error\n";
+          e.print_info(std::cerr);
+          std::cerr << std::endl;
+        }
+      return 1;
+    }
+  catch (const std::exception &e)
+    {
+      if (root)
+        std::cerr << "\ndealii-mpm: error: " << e.what() << std::endl;
+      return 1;
+    }
+  return 0;
+}

@@ -1,0 +1,245 @@
+#include <mpm/core/point_generation.h>
+#include <mpm/dealii/material_points.h>
+
+#include <deal.II/base/mpi.h>
+
+#include <cmath>
+
+namespace mpm
+{
+  template <int dim>
+  std::vector<std::string> PropertyLayout<dim>::names()
+  {
+    const char *axis[3] = {"x", "y", "z"};
+    const char *voigt[6] = {"xx", "yy", "zz", "xy", "yz", "xz"};
+    std::vector<std::string> n = {"mass", "volume", "initial_volume"};
+    for (int d = 0; d < dim; ++d)
+      n.push_back("velocity");
+    for (const char *c : voigt)
+      n.push_back(std::string("stress_") + c);
+    for (const char *c : voigt)
+      n.push_back(std::string("strain_") + c);
+    for (int a = 0; a < dim; ++a)
+      for (int b = 0; b < dim; ++b)
+        n.push_back(std::string("F_") + axis[a] + axis[b]);
+    for (int d = 0; d < dim; ++d)
+      n.push_back("domain_half_length");
+    for (int d = 0; d < dim; ++d)
+      n.push_back("initial_domain_half_length");
+    n.push_back("plastic_strain");
+    n.push_back("material_id");
+    for (int d = 0; d < dim; ++d)
+      n.push_back("initial_position");
+    return n;
+  }
+
+  template <int dim>
+  std::vector<dealii::DataComponentInterpretation::DataComponentInterpretation>
+  PropertyLayout<dim>::interpretations()
+  {
+    using namespace dealii::DataComponentInterpretation;
+    std::vector<DataComponentInterpretation> k(n_properties, component_is_scalar);
+    for (unsigned int d = 0; d < dim; ++d)
+      {
+        k[velocity + d]                   = component_is_part_of_vector;
+        k[domain_half_length + d]         = component_is_part_of_vector;
+        k[initial_domain_half_length + d] = component_is_part_of_vector;
+        k[initial_position + d]           = component_is_part_of_vector;
+      }
+    return k;
+  }
+
+  template <int dim>
+  MaterialPoints<dim>::MaterialPoints(BackgroundGrid<dim> &grid, const Parameters &)
+    : handler(grid.triangulation, grid.mapping, PropertyLayout<dim>::n_properties)
+    , grid(grid)
+  {}
+
+  namespace
+  {
+    // Height of the polygon's upper boundary above horizontal coordinate x.
+    double polygon_top(const std::vector<std::array<double, 2>> &polygon, const double x)
+    {
+      double top = -1e300;
+      for (size_t i = 0, j = polygon.size() - 1; i < polygon.size(); j = i++)
+        {
+          const auto &a = polygon[j], &b = polygon[i];
+          if ((a[0] <= x && x <= b[0]) || (b[0] <= x && x <= a[0]))
+            {
+              const double t = a[0] == b[0] ? 0.0 : (x - a[0]) / (b[0] - a[0]);
+              top            = std::max(top, a[1] + t * (b[1] - a[1]));
+            }
+        }
+      return top;
+    }
+  } // namespace
+
+  template <int dim>
+  void MaterialPoints<dim>::generate(const Parameters &parameters)
+  {
+    using Layout = PropertyLayout<dim>;
+    // Geometry of the lattice only: point generation needs no node arrays.
+    HostGrid<dim, double> lattice;
+    lattice.h = grid.h;
+    for (int d = 0; d < dim; ++d)
+      {
+        lattice.origin[d]  = grid.origin[d];
+        lattice.n_cells[d] = grid.n_cells[d];
+      }
+
+    dealii::types::particle_index id = 0;
+    for (unsigned int b = 0; b < parameters.bodies.size(); ++b)
+      {
+        const BodyParameters &body = parameters.bodies[b];
+        BodyDescription<dim, double> description;
+        description.points_per_direction = body.points_per_direction;
+        description.density              = body.density;
+        description.material             = parameters.body_material[b];
+        for (int d = 0; d < dim; ++d)
+          description.velocity[d] = body.velocity[d];
+
+        double lower[dim], upper[dim];
+        for (int d = 0; d < dim; ++d)
+          {
+            lower[d] = body.lower[d];
+            upper[d] = body.upper[d];
+          }
+        std::vector<double> px, pv;
+        if (body.shape == "polygon")
+          {
+            for (const auto &v : body.polygon)
+              {
+                px.push_back(v[0]);
+                pv.push_back(v[1]);
+              }
+            lower[0] = *std::min_element(px.begin(), px.end());
+            upper[0] = *std::max_element(px.begin(), px.end());
+            lower[dim - 1] = *std::min_element(pv.begin(), pv.end());
+            upper[dim - 1] = *std::max_element(pv.begin(), pv.end());
+          }
+        HostPoints<dim, double> points;
+        add_points(points, lattice, lower, upper, description, [&](const double *x) {
+          return body.shape != "polygon" || inside_polygon(px, pv, x[0], x[dim - 1]);
+        });
+
+        const double g_vertical = std::abs(parameters.gravity[dim - 1]);
+        for (int i = 0; i < points.size(); ++i, ++id)
+          {
+            double x[dim];
+            for (int d = 0; d < dim; ++d)
+              x[d] = points.position[d][i];
+            const auto cell = grid.owned_cell(grid.lattice_cell_of(x));
+            if (cell == grid.triangulation.end())
+              continue; // another rank owns this point's cell
+
+            std::vector<double> properties(Layout::n_properties, 0.0);
+            properties[Layout::mass]           = points.mass[i];
+            properties[Layout::volume]         = points.volume[i];
+            properties[Layout::initial_volume] = points.initial_volume[i];
+            for (int d = 0; d < dim; ++d)
+              {
+                properties[Layout::velocity + d]                   = points.velocity[d][i];
+                properties[Layout::domain_half_length + d]         = points.domain_half_length[d][i];
+                properties[Layout::initial_domain_half_length + d] = points.initial_domain_half_length[d][i];
+                properties[Layout::deformation_gradient + d * dim + d] = 1.0;
+                properties[Layout::initial_position + d]           = x[d];
+              }
+            if (body.initial_stress == "geostatic")
+              {
+                const double top = body.shape == "polygon" ? polygon_top(body.polygon, x[0]) : upper[dim - 1];
+                const double sv  = -body.density * g_vertical * std::max(0.0, top - x[dim - 1]);
+                properties[Layout::stress + 0] = body.k0 * sv;
+                properties[Layout::stress + 1] = dim == 2 ? sv : body.k0 * sv;
+                properties[Layout::stress + 2] = dim == 2 ? body.k0 * sv : sv;
+              }
+            properties[Layout::material] = parameters.body_material[b];
+
+            dealii::Point<dim> location;
+            for (int d = 0; d < dim; ++d)
+              location[d] = x[d];
+            const dealii::Point<dim> reference = grid.mapping.transform_real_to_unit_cell(cell, location);
+            dealii::Particles::Particle<dim> particle(location, reference, id);
+            auto it = handler.insert_particle(particle, cell);
+            it->set_properties(properties);
+          }
+      }
+    n_generated = id;
+    handler.update_cached_numbers();
+  }
+
+  template <int dim>
+  void MaterialPoints<dim>::copy_to(HostPoints<dim, double> &p) const
+  {
+    using Layout = PropertyLayout<dim>;
+    p.resize(0);
+    p.resize(handler.n_locally_owned_particles());
+    int i = 0;
+    for (const auto &particle : handler)
+      {
+        const auto x    = particle.get_location();
+        const auto prop = particle.get_properties();
+        for (int d = 0; d < dim; ++d)
+          {
+            p.position[d][i]                   = x[d];
+            p.velocity[d][i]                   = prop[Layout::velocity + d];
+            p.domain_half_length[d][i]         = prop[Layout::domain_half_length + d];
+            p.initial_domain_half_length[d][i] = prop[Layout::initial_domain_half_length + d];
+          }
+        for (int c = 0; c < n_voigt; ++c)
+          {
+            p.stress[c][i] = prop[Layout::stress + c];
+            p.strain[c][i] = prop[Layout::strain + c];
+          }
+        for (int c = 0; c < dim * dim; ++c)
+          p.deformation_gradient[c][i] = prop[Layout::deformation_gradient + c];
+        p.mass[i]           = prop[Layout::mass];
+        p.volume[i]         = prop[Layout::volume];
+        p.initial_volume[i] = prop[Layout::initial_volume];
+        p.plastic_strain[i] = prop[Layout::plastic_strain];
+        p.material[i]       = static_cast<int>(prop[Layout::material]);
+        ++i;
+      }
+  }
+
+  template <int dim>
+  unsigned int MaterialPoints<dim>::copy_from(const HostPoints<dim, double> &p)
+  {
+    using Layout = PropertyLayout<dim>;
+    std::vector<typename dealii::Particles::ParticleHandler<dim>::particle_iterator> removed;
+    int i = 0;
+    for (auto particle = handler.begin(); particle != handler.end(); ++particle, ++i)
+      {
+        if (p.material[i] < 0)
+          {
+            removed.push_back(particle);
+            continue;
+          }
+        dealii::Point<dim> x;
+        auto prop = particle->get_properties();
+        for (int d = 0; d < dim; ++d)
+          {
+            x[d]                                   = p.position[d][i];
+            prop[Layout::velocity + d]             = p.velocity[d][i];
+            prop[Layout::domain_half_length + d]   = p.domain_half_length[d][i];
+          }
+        for (int c = 0; c < n_voigt; ++c)
+          {
+            prop[Layout::stress + c] = p.stress[c][i];
+            prop[Layout::strain + c] = p.strain[c][i];
+          }
+        for (int c = 0; c < dim * dim; ++c)
+          prop[Layout::deformation_gradient + c] = p.deformation_gradient[c][i];
+        prop[Layout::volume]         = p.volume[i];
+        prop[Layout::plastic_strain] = p.plastic_strain[i];
+        particle->set_location(x);
+      }
+    handler.remove_particles(removed);
+    handler.sort_particles_into_subdomains_and_cells();
+    return static_cast<unsigned int>(removed.size());
+  }
+
+  template struct PropertyLayout<2>;
+  template struct PropertyLayout<3>;
+  template class MaterialPoints<2>;
+  template class MaterialPoints<3>;
+} // namespace mpm

@@ -1,0 +1,401 @@
+#include <mpm/dealii/material_library.h>
+#include <mpm/dealii/parameters.h>
+
+#include <deal.II/base/exceptions.h>
+#include <deal.II/base/utilities.h>
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+namespace mpm
+{
+  using dealii::ExcMessage;
+  using dealii::ParameterHandler;
+  namespace Patterns = dealii::Patterns;
+
+  namespace
+  {
+    const char *axis_names[3] = {"x", "y", "z"};
+
+    std::string zeros(const unsigned int dim, const double last = 0)
+    {
+      std::string s;
+      for (unsigned int d = 0; d < dim; ++d)
+        s += (d ? ", " : "") + dealii::Utilities::to_string(d + 1 == dim ? last : 0.0);
+      return s;
+    }
+
+    std::string ones(const unsigned int dim)
+    {
+      std::string s;
+      for (unsigned int d = 0; d < dim; ++d)
+        s += d ? ", 1" : "1";
+      return s;
+    }
+
+    Patterns::List point_pattern(const unsigned int dim)
+    {
+      return Patterns::List(Patterns::Double(), dim, dim, ",");
+    }
+
+    std::vector<double> get_point(ParameterHandler &prm, const std::string &entry)
+    {
+      return dealii::Utilities::string_to_double(dealii::Utilities::split_string_list(prm.get(entry), ','));
+    }
+
+    std::string join(const std::vector<std::string> &items)
+    {
+      std::string s;
+      for (const std::string &item : items)
+        s += (s.empty() ? "" : ", ") + item;
+      return s;
+    }
+
+    [[noreturn]] void fail(const std::string &entry, const std::string &what)
+    {
+      AssertThrow(false, ExcMessage("Parameter '" + entry + "': " + what));
+      throw; // not reached
+    }
+
+    // First pass: only what decides how the full set of entries is declared.
+    void declare_layout(ParameterHandler &prm)
+    {
+      prm.declare_entry("Dimension", "2", Patterns::Integer(2, 3),
+                        "Space dimension of the run: 2 (plane strain) or 3.");
+      prm.enter_subsection("Materials");
+      prm.declare_entry("Names", "soil", Patterns::List(Patterns::Anything(), 1),
+                        "Comma-separated names of the materials; each has a subsection 'Material <name>'.");
+      prm.leave_subsection();
+      prm.enter_subsection("Material points");
+      prm.declare_entry("Number of bodies", "1", Patterns::Integer(1, 1000),
+                        "Number of bodies of material points; each has a subsection 'Body <i>', i = 1..n.");
+      prm.leave_subsection();
+    }
+  } // namespace
+
+  void Parameters::declare(ParameterHandler &prm, const unsigned int dim, const unsigned int n_bodies,
+                           const std::vector<std::string> &material_names)
+  {
+    declare_layout(prm);
+
+    prm.enter_subsection("Grid");
+    prm.declare_entry("Lower corner", zeros(dim), point_pattern(dim),
+                      "Lower corner of the background grid, one coordinate per dimension (m).");
+    prm.declare_entry("Upper corner", ones(dim), point_pattern(dim),
+                      "Upper corner of the background grid (m). Each extent must be a multiple of the cell size.");
+    prm.declare_entry("Cell size", "0.1", Patterns::Double(0),
+                      "Edge length h of the square/cubic grid cells (m), the same in every direction.");
+    prm.leave_subsection();
+
+    prm.enter_subsection("Boundary conditions");
+    for (unsigned int d = 0; d < dim; ++d)
+      for (const std::string side : {"min", "max"})
+        prm.declare_entry(std::string(axis_names[d]) + " " + side, "free",
+                          Patterns::Selection("free|no-slip|free-slip"),
+                          std::string("Condition on the grid face ") + axis_names[d] + " = " + side +
+                            " (boundary id " + std::to_string(2 * d + (side == std::string("max"))) +
+                            "): free, no-slip (all velocity components zero) or free-slip (roller: normal "
+                            "component zero).");
+    prm.leave_subsection();
+
+    prm.enter_subsection("Solver");
+    prm.declare_entry("End time", "1", Patterns::Double(0), "Simulated end time (s).");
+    prm.declare_entry("Update scheme", "MUSL", Patterns::Selection("MUSL|USL|USF"),
+                      "Explicit update scheme: MUSL (modified update stress last, default), USL or USF.");
+    prm.declare_entry("Shape function", "GIMP", Patterns::Selection("linear|GIMP"),
+                      "Grid shape functions: linear (standard MPM) or GIMP (generalised interpolation).");
+    prm.declare_entry("GIMP domain update", "none", Patterns::Selection("none|det F|F_ii"),
+                      "How GIMP particle domains follow the deformation: none (uGIMP), det F (cpGIMP, "
+                      "half-lengths scaled by det(F)^(1/dim)) or F_ii (cpGIMP, half-length i scaled by F_ii; exact "
+                      "for stretch along the axes, wrong under rotation). Only with Shape function = GIMP.");
+    prm.declare_entry("Time step", "adaptive", Patterns::Selection("adaptive|fixed"),
+                      "adaptive: dt = CFL number * h / (c_el + max |v_p|); fixed: dt = Fixed time step.");
+    prm.declare_entry("CFL number", "0.5", Patterns::Double(0, 1),
+                      "Courant number alpha of the adaptive time step, 0 < alpha <= 1.");
+    prm.declare_entry("Fixed time step", "1e-4", Patterns::Double(0),
+                      "Time step (s) when Time step = fixed; must not exceed h / c_el.");
+    prm.declare_entry("Local damping", "0", Patterns::Double(0, 1),
+                      "Local (Cundall) damping D: nodal force f <- f - D |f| sign(v), 0 <= D < 1.");
+    prm.declare_entry("FLIP fraction", "1", Patterns::Double(0, 1),
+                      "Velocity update: 1 = pure FLIP, 0 = pure PIC, in between a blend.");
+    prm.declare_entry("Gravity", zeros(dim, -9.81), point_pattern(dim),
+                      "Gravitational acceleration vector (m/s^2).");
+    prm.declare_entry("Gravity ramp time", "0", Patterns::Double(0),
+                      "Gravity grows linearly from 0 to its full value over this time (s); 0 = applied at once.");
+    prm.declare_entry("Maximum number of steps", "0", Patterns::Integer(0),
+                      "Stop after this many steps even before End time; 0 = no limit.");
+    prm.leave_subsection();
+
+    prm.enter_subsection("Materials");
+    prm.leave_subsection();
+    for (const std::string &name : material_names)
+      {
+        prm.enter_subsection("Material " + name);
+        prm.declare_entry("Model", "linear elastic", Patterns::Selection(material_model_names()),
+                          "Constitutive model of this material, one of: " + material_model_names() + ".");
+        for (const auto &[model, plugin] : material_library())
+          {
+            prm.enter_subsection(model);
+            plugin.declare_parameters(prm);
+            prm.leave_subsection();
+          }
+        prm.leave_subsection();
+      }
+
+    prm.enter_subsection("Material points");
+    for (unsigned int b = 1; b <= n_bodies; ++b)
+      {
+        prm.enter_subsection("Body " + std::to_string(b));
+        prm.declare_entry("Shape", "box", Patterns::Selection("box|polygon"),
+                          "box: the points fill [Lower corner, Upper corner]. polygon: the points fill the polygon "
+                          "given by 'Polygon vertices' in the (x, vertical) plane; in 3D it is extruded along y "
+                          "between the y coordinates of Lower and Upper corner.");
+        prm.declare_entry("Lower corner", zeros(dim), point_pattern(dim), "Lower corner of the box (m).");
+        prm.declare_entry("Upper corner", ones(dim), point_pattern(dim), "Upper corner of the box (m).");
+        prm.declare_entry("Polygon vertices", "",
+                          Patterns::List(Patterns::List(Patterns::Double(), 2, 2, ","), 0,
+                                         Patterns::List::max_int_value, ";"),
+                          "Vertices 'x1, v1; x2, v2; ...' of the polygon (at least 3), v the vertical "
+                          "coordinate (y in 2D, z in 3D).");
+        prm.declare_entry("Points per cell direction", "2", Patterns::Integer(1, 10),
+                          "Material points per cell along each direction (2 gives 2x2 in 2D, 2x2x2 in 3D).");
+        prm.declare_entry("Density", "1000", Patterns::Double(0), "Mass density (kg/m^3, > 0).");
+        prm.declare_entry("Initial velocity", zeros(dim), point_pattern(dim), "Initial velocity (m/s).");
+        prm.declare_entry("Material", material_names.front(), Patterns::Anything(),
+                          "Name of this body's material, one of the names in Materials/Names.");
+        prm.declare_entry("Initial stress", "none", Patterns::Selection("none|geostatic"),
+                          "none: stress free. geostatic: vertical stress -rho |g| (depth below the body's top "
+                          "surface above the point), horizontal stresses K0 times it.");
+        prm.declare_entry("K0", "0.5", Patterns::Double(0), "Lateral earth pressure coefficient for geostatic.");
+        prm.leave_subsection();
+      }
+    prm.leave_subsection();
+
+    prm.enter_subsection("Output");
+    prm.declare_entry("Directory", "output", Patterns::DirectoryName(),
+                      "Folder for .vtu/.pvtu/.pvd files and the time history; created if missing.");
+    prm.declare_entry("Output interval", "0.1", Patterns::Double(0),
+                      "Simulated time between field outputs (s); 0 = only the initial and final states.");
+    prm.declare_entry("Write grid fields", "true", Patterns::Bool(),
+                      "Write nodal mass and velocity of the background grid with each output.");
+    prm.declare_entry("Write particles", "true", Patterns::Bool(),
+                      "Write every material point with all its properties with each output.");
+    prm.declare_entry("History every n steps", "10", Patterns::Integer(1),
+                      "Steps between rows of the time history (history.csv).");
+    prm.declare_entry("Progress interval", "2", Patterns::Double(0),
+                      "Wall-clock seconds between progress lines on the screen; 0 = none.");
+    prm.leave_subsection();
+
+    prm.enter_subsection("Backend");
+    prm.declare_entry("Backend", "cpu", Patterns::Selection("cpu|cuda"),
+                      "Where the MPM step runs: cpu (threads through TBB) or cuda (needs a build with "
+                      "-DMPM_WITH_CUDA=ON and a CUDA device).");
+    prm.leave_subsection();
+  }
+
+  void Parameters::parse(ParameterHandler &prm)
+  {
+    dim = prm.get_integer("Dimension");
+
+    prm.enter_subsection("Grid");
+    lower     = get_point(prm, "Lower corner");
+    upper     = get_point(prm, "Upper corner");
+    cell_size = prm.get_double("Cell size");
+    if (!(cell_size > 0))
+      fail("Grid/Cell size", "must be > 0, got " + prm.get("Cell size") + ".");
+    for (unsigned int d = 0; d < dim; ++d)
+      {
+        if (!(upper[d] > lower[d]))
+          fail("Grid/Upper corner", std::string("must exceed Lower corner in ") + axis_names[d] + ".");
+        const double n = (upper[d] - lower[d]) / cell_size;
+        if (std::abs(n - std::round(n)) > 1e-8 * std::max(1.0, n))
+          fail("Grid/Cell size", std::string("the extent in ") + axis_names[d] + " (" +
+                                   dealii::Utilities::to_string(upper[d] - lower[d]) +
+                                   " m) is not a whole number of cells of size " + prm.get("Cell size") + ".");
+      }
+    prm.leave_subsection();
+
+    prm.enter_subsection("Boundary conditions");
+    for (unsigned int d = 0; d < dim; ++d)
+      for (unsigned int side = 0; side < 2; ++side)
+        {
+          const std::string v = prm.get(std::string(axis_names[d]) + (side ? " max" : " min"));
+          boundary[2 * d + side] =
+            v == "no-slip" ? BoundaryType::no_slip : (v == "free-slip" ? BoundaryType::free_slip : BoundaryType::free);
+        }
+    prm.leave_subsection();
+
+    prm.enter_subsection("Solver");
+    end_time = prm.get_double("End time");
+    const std::string s = prm.get("Update scheme");
+    scheme = s == "USL" ? UpdateScheme::usl : (s == "USF" ? UpdateScheme::usf : UpdateScheme::musl);
+    shape_function = prm.get("Shape function") == "GIMP" ? ShapeFunction::gimp : ShapeFunction::linear;
+    const std::string du = prm.get("GIMP domain update");
+    domain_update = du == "det F" ? DomainUpdate::det_F : (du == "F_ii" ? DomainUpdate::stretch : DomainUpdate::none);
+    if (shape_function == ShapeFunction::linear && domain_update != DomainUpdate::none)
+      fail("Solver/GIMP domain update", "'" + du + "' needs Shape function = GIMP; with linear shape functions "
+                                        "the only allowed value is none.");
+    adaptive_time_step = prm.get("Time step") == "adaptive";
+    cfl                = prm.get_double("CFL number");
+    if (!(cfl > 0))
+      fail("Solver/CFL number", "must satisfy 0 < CFL <= 1, got " + prm.get("CFL number") + ".");
+    fixed_time_step = prm.get_double("Fixed time step");
+    if (!adaptive_time_step && !(fixed_time_step > 0))
+      fail("Solver/Fixed time step", "must be > 0 when Time step = fixed.");
+    damping = prm.get_double("Local damping");
+    if (!(damping < 1))
+      fail("Solver/Local damping", "must satisfy 0 <= D < 1, got " + prm.get("Local damping") + ".");
+    flip_fraction     = prm.get_double("FLIP fraction");
+    gravity           = get_point(prm, "Gravity");
+    gravity_ramp_time = prm.get_double("Gravity ramp time");
+    max_steps         = prm.get_integer("Maximum number of steps");
+    prm.leave_subsection();
+
+    prm.enter_subsection("Materials");
+    material_names = dealii::Utilities::split_string_list(prm.get("Names"), ',');
+    prm.leave_subsection();
+    for (unsigned int i = 0; i < material_names.size(); ++i)
+      for (unsigned int j = 0; j < i; ++j)
+        if (material_names[i] == material_names[j])
+          fail("Materials/Names", "the name '" + material_names[i] + "' appears twice.");
+    for (const std::string &name : material_names)
+      {
+        prm.enter_subsection("Material " + name);
+        const std::string model = prm.get("Model");
+        prm.enter_subsection(model);
+        try
+          {
+            materials.push_back(material_library().at(model).parse_parameters(prm));
+          }
+        catch (const dealii::ExceptionBase &e)
+          {
+            std::ostringstream info;
+            e.print_info(info);
+            fail("Material " + name + "/" + model, info.str());
+          }
+        prm.leave_subsection();
+        prm.leave_subsection();
+        material_models.push_back(model);
+      }
+
+    prm.enter_subsection("Material points");
+    const unsigned int n_bodies = prm.get_integer("Number of bodies");
+    for (unsigned int b = 1; b <= n_bodies; ++b)
+      {
+        const std::string where = "Material points/Body " + std::to_string(b) + "/";
+        prm.enter_subsection("Body " + std::to_string(b));
+        BodyParameters body;
+        body.shape = prm.get("Shape");
+        body.lower = get_point(prm, "Lower corner");
+        body.upper = get_point(prm, "Upper corner");
+        for (const std::string &vertex :
+             dealii::Utilities::split_string_list(prm.get("Polygon vertices"), ';'))
+          {
+            const auto xy = dealii::Utilities::string_to_double(dealii::Utilities::split_string_list(vertex, ','));
+            body.polygon.push_back({{xy[0], xy[1]}});
+          }
+        body.points_per_direction = prm.get_integer("Points per cell direction");
+        body.density              = prm.get_double("Density");
+        body.velocity             = get_point(prm, "Initial velocity");
+        body.material             = prm.get("Material");
+        body.initial_stress       = prm.get("Initial stress");
+        body.k0                   = prm.get_double("K0");
+        prm.leave_subsection();
+
+        if (!(body.density > 0))
+          fail(where + "Density", "must be > 0.");
+        unsigned int material_index = material_names.size();
+        for (unsigned int m = 0; m < material_names.size(); ++m)
+          if (material_names[m] == body.material)
+            material_index = m;
+        if (material_index == material_names.size())
+          fail(where + "Material", "'" + body.material + "' is not one of Materials/Names (" +
+                                     prm.get("Material") + " given; allowed: " +
+                                     join(material_names) + ").");
+        if (body.shape == "polygon" && body.polygon.size() < 3)
+          fail(where + "Polygon vertices", "a polygon needs at least 3 vertices, got " +
+                                             std::to_string(body.polygon.size()) + ".");
+        // The body must lie inside the grid: a point outside could never be used.
+        std::vector<double> lo = body.lower, hi = body.upper;
+        if (body.shape == "polygon")
+          {
+            lo[0] = hi[0] = body.polygon[0][0];
+            lo[dim - 1] = hi[dim - 1] = body.polygon[0][1];
+            for (const auto &v : body.polygon)
+              {
+                lo[0]       = std::min(lo[0], v[0]);
+                hi[0]       = std::max(hi[0], v[0]);
+                lo[dim - 1] = std::min(lo[dim - 1], v[1]);
+                hi[dim - 1] = std::max(hi[dim - 1], v[1]);
+              }
+          }
+        const std::string extent = body.shape == "polygon" ? "Polygon vertices" : "Lower corner";
+        for (unsigned int d = 0; d < dim; ++d)
+          {
+            if (!(hi[d] > lo[d]))
+              fail(where + (body.shape == "polygon" ? extent : std::string("Upper corner")),
+                   std::string("the body has no extent in ") + axis_names[d] + ".");
+            if (lo[d] < lower[d] - 1e-12 || hi[d] > upper[d] + 1e-12)
+              fail(where + extent, std::string("the body reaches outside the grid in ") + axis_names[d] + " ([" +
+                                     dealii::Utilities::to_string(lo[d]) + ", " +
+                                     dealii::Utilities::to_string(hi[d]) + "] is not inside [" +
+                                     dealii::Utilities::to_string(lower[d]) + ", " +
+                                     dealii::Utilities::to_string(upper[d]) + "]).");
+          }
+        bodies.push_back(body);
+        body_material.push_back(material_index);
+      }
+    prm.leave_subsection();
+
+    prm.enter_subsection("Output");
+    output_directory  = prm.get("Directory");
+    output_interval   = prm.get_double("Output interval");
+    write_grid_fields = prm.get_bool("Write grid fields");
+    write_particles   = prm.get_bool("Write particles");
+    history_every     = prm.get_integer("History every n steps");
+    progress_interval = prm.get_double("Progress interval");
+    prm.leave_subsection();
+
+    prm.enter_subsection("Backend");
+    backend = prm.get("Backend");
+    prm.leave_subsection();
+  }
+
+  Parameters read_parameters(const std::string &filename)
+  {
+    {
+      std::ifstream in(filename);
+      AssertThrow(in, ExcMessage("Cannot open the parameter file '" + filename + "'."));
+    }
+    // Pass 1: dimension, bodies and material names; everything else is skipped.
+    ParameterHandler layout;
+    declare_layout(layout);
+    layout.parse_input(filename, "", /*skip_undefined=*/true);
+    const unsigned int dim = layout.get_integer("Dimension");
+    layout.enter_subsection("Material points");
+    const unsigned int n_bodies = layout.get_integer("Number of bodies");
+    layout.leave_subsection();
+    layout.enter_subsection("Materials");
+    const std::vector<std::string> names = dealii::Utilities::split_string_list(layout.get("Names"), ',');
+    layout.leave_subsection();
+
+    // Pass 2: every entry declared, unknown ones rejected.
+    ParameterHandler prm;
+    Parameters::declare(prm, dim, n_bodies, names);
+    prm.parse_input(filename, "", /*skip_undefined=*/false, /*assert_mandatory_entries_are_found=*/false);
+    Parameters parameters;
+    parameters.parse(prm);
+    return parameters;
+  }
+
+  void print_parameters(std::ostream &out, const unsigned int dim, const std::string &style)
+  {
+    ParameterHandler prm;
+    Parameters::declare(prm, dim, 1, {"soil"});
+    const ParameterHandler::OutputStyle s =
+      style == "json" ? ParameterHandler::JSON : (style == "description" ? ParameterHandler::Description :
+                                                                          ParameterHandler::PRM);
+    prm.print_parameters(out, s);
+  }
+} // namespace mpm

@@ -1,0 +1,196 @@
+#include <mpm/dealii/background_grid.h>
+#include <mpm/dealii/engine.h>
+#include <mpm/dealii/material_points.h>
+#include <mpm/dealii/output_writer.h>
+#include <mpm/dealii/simulator.h>
+
+#include <deal.II/base/conditional_ostream.h>
+#include <deal.II/base/mpi.h>
+#include <deal.II/base/timer.h>
+
+#include <chrono>
+#include <cmath>
+#include <iomanip>
+#include <iostream>
+
+namespace mpm
+{
+  using dealii::Utilities::MPI::max;
+  using dealii::Utilities::MPI::min;
+  using dealii::Utilities::MPI::sum;
+
+  template <int dim>
+  Simulator<dim>::Simulator(const Parameters &parameters, MPI_Comm communicator)
+    : parameters(parameters)
+    , communicator(communicator)
+  {}
+
+  namespace
+  {
+    template <int dim>
+    PointTotals<dim, double> global_totals(PointTotals<dim, double> t, MPI_Comm comm)
+    {
+      t.mass           = sum(t.mass, comm);
+      t.kinetic_energy = sum(t.kinetic_energy, comm);
+      t.n_points       = sum(t.n_points, comm);
+      for (int d = 0; d < dim; ++d)
+        {
+          t.momentum[d] = sum(t.momentum[d], comm);
+          t.lower[d]    = min(t.lower[d], comm);
+          t.upper[d]    = max(t.upper[d], comm);
+        }
+      return t;
+    }
+
+    // Largest elastic wave speed over the bodies, sqrt((K + 4G/3) / rho).
+    double elastic_wave_speed(const Parameters &p)
+    {
+      double c = 0;
+      for (unsigned int b = 0; b < p.bodies.size(); ++b)
+        c = std::max(c, std::sqrt(p.materials[p.body_material[b]].elastic.p_wave_modulus() / p.bodies[b].density));
+      return c;
+    }
+  } // namespace
+
+  template <int dim>
+  void Simulator<dim>::run()
+  {
+    dealii::ConditionalOStream pcout(std::cout, dealii::Utilities::MPI::this_mpi_process(communicator) == 0);
+    dealii::TimerOutput timer(communicator, pcout, dealii::TimerOutput::summary, dealii::TimerOutput::wall_times);
+    const auto wall_start = std::chrono::steady_clock::now();
+
+    // Set-up: grid, material points, engine, output.
+    timer.enter_subsection("setup");
+    BackgroundGrid<dim> grid(parameters, communicator);
+    MaterialPoints<dim> points(grid, parameters);
+    points.generate(parameters);
+    const long n_points_initial = static_cast<long>(points.handler.n_global_particles());
+    AssertThrow(n_points_initial > 0,
+                dealii::ExcMessage("Parameter 'Material points': the bodies contain no material point (each body "
+                                   "must cover at least one point site of the grid)."));
+    auto engine = make_engine<dim>(parameters.backend, grid, parameters.materials, parameters.shape_function);
+    engine->load(points);
+    OutputWriter<dim> output(parameters, communicator);
+    timer.leave_subsection();
+
+    const double c_el = elastic_wave_speed(parameters);
+    const double h    = parameters.cell_size;
+    if (!parameters.adaptive_time_step)
+      AssertThrow(parameters.fixed_time_step * c_el <= h,
+                  dealii::ExcMessage("Parameter 'Solver/Fixed time step': " +
+                                     dealii::Utilities::to_string(parameters.fixed_time_step) +
+                                     " s exceeds the elastic stability limit h / c_el = " +
+                                     dealii::Utilities::to_string(h / c_el) + " s (CFL > 1)."));
+    pcout << "dealii-mpm: " << dim << "D, " << grid.triangulation.n_global_active_cells() << " cells, "
+          << grid.dof_handler.n_dofs() << " nodes, " << n_points_initial << " material points, "
+          << dealii::Utilities::MPI::n_mpi_processes(communicator) << " MPI rank(s), backend "
+          << parameters.backend << "\n"
+          << "  elastic wave speed " << c_el << " m/s, end time " << parameters.end_time << " s, output in '"
+          << output.directory() << "'" << std::endl;
+
+    StepSettings<dim, double> settings;
+    settings.scheme         = parameters.scheme;
+    settings.damping        = parameters.damping;
+    settings.flip_fraction  = parameters.flip_fraction;
+    settings.domain_update  = parameters.domain_update;
+    settings.mass_tolerance = 0;
+    {
+      // Nodes lighter than 1e-12 of the smallest point carry no velocity.
+      double m_min = 1e300;
+      for (const auto &p : points.handler)
+        m_min = std::min(m_min, p.get_properties()[PropertyLayout<dim>::mass]);
+      settings.mass_tolerance = 1e-12 * min(m_min, communicator);
+    }
+
+    double time = 0, max_speed = 0, work_of_gravity = 0, dt = 0;
+    long   step = 0, n_removed = 0;
+    double next_output = parameters.output_interval;
+    auto   last_progress = std::chrono::steady_clock::now();
+
+    auto record_history = [&]() {
+      dealii::TimerOutput::Scope scope(timer, "history");
+      const auto totals = global_totals<dim>(engine->totals(), communicator);
+      n_removed         = n_points_initial - totals.n_points;
+      output.write_history({time, dt, work_of_gravity, step, n_removed, totals});
+    };
+    auto write_output = [&]() {
+      dealii::TimerOutput::Scope scope(timer, "output");
+      engine->store(points);
+      output.write_fields(time, grid, points);
+    };
+
+    write_output();
+    record_history();
+
+    const double end = parameters.end_time;
+    while (time < end * (1 - 1e-12) && (parameters.max_steps == 0 || step < long(parameters.max_steps)))
+      {
+        dt = parameters.adaptive_time_step ? parameters.cfl * h / (c_el + max_speed) : parameters.fixed_time_step;
+        dt = std::min(dt, end - time);
+        if (parameters.output_interval > 0)
+          dt = std::min(dt, std::max(next_output - time, 1e-12 * end)); // land on output times
+
+        const double ramp = parameters.gravity_ramp_time > 0 ? std::min(1.0, time / parameters.gravity_ramp_time) : 1.0;
+        for (int d = 0; d < dim; ++d)
+          settings.gravity[d] = ramp * parameters.gravity[d];
+
+        StepReduction<double> r;
+        {
+          dealii::TimerOutput::Scope scope(timer, "MPM step");
+          r = engine->step(settings, dt);
+        }
+        max_speed = max(r.max_speed, communicator);
+        work_of_gravity += dt * sum(r.gravity_power, communicator);
+        time += dt;
+        ++step;
+        AssertThrow(std::isfinite(max_speed),
+                    dealii::ExcMessage("The simulation became unstable at t = " + dealii::Utilities::to_string(time) +
+                                       " s (step " + std::to_string(step) +
+                                       "): a velocity is not finite. Reduce 'Solver/CFL number' or the time step."));
+
+        if (step % parameters.history_every == 0)
+          record_history();
+        if (parameters.output_interval > 0 && time >= next_output * (1 - 1e-12))
+          {
+            write_output();
+            while (next_output <= time * (1 + 1e-12))
+              next_output += parameters.output_interval;
+          }
+
+        const auto now = std::chrono::steady_clock::now();
+        if (parameters.progress_interval > 0 &&
+            std::chrono::duration<double>(now - last_progress).count() >= parameters.progress_interval)
+          {
+            const double elapsed = std::chrono::duration<double>(now - wall_start).count();
+            const double eta     = elapsed / time * (end - time);
+            pcout << "  t = " << std::setw(10) << time << " s  step " << step << "  dt " << dt << "  "
+                  << std::setprecision(4) << step / elapsed << " steps/s  ETA " << eta << " s" << std::endl;
+            last_progress = now;
+          }
+      }
+
+    if (step % parameters.history_every != 0)
+      record_history();
+    if (!(parameters.output_interval > 0 && std::abs(time - (next_output - parameters.output_interval)) < 1e-12 * end))
+      write_output();
+
+    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+    const double n_now = static_cast<double>(n_points_initial - n_removed);
+    pcout << "dealii-mpm: done, t = " << time << " s after " << step << " steps in " << wall << " s wall ("
+          << std::setprecision(3) << (n_now * step) / wall << " point-updates/s); " << n_removed
+          << " material point(s) left the grid and were removed.\n"
+          << "  results: " << output.directory() << "/particles.pvd, " << output.directory()
+          << "/grid.pvd, " << output.directory() << "/history.csv" << std::endl;
+  }
+
+  void run_simulation(const Parameters &parameters, MPI_Comm communicator)
+  {
+    if (parameters.dim == 2)
+      Simulator<2>(parameters, communicator).run();
+    else
+      Simulator<3>(parameters, communicator).run();
+  }
+
+  template class Simulator<2>;
+  template class Simulator<3>;
+} // namespace mpm
