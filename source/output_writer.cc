@@ -36,7 +36,7 @@ namespace mpm
           history << ",min_" << "xyz"[d];
         for (int d = 0; d < dim; ++d)
           history << ",max_" << "xyz"[d];
-        history << "\n" << std::setprecision(10);
+        history << "\n" << std::setprecision(16);
       }
     MPI_Barrier(communicator); // the folder exists before any rank writes into it
   }

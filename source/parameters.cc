@@ -310,8 +310,7 @@ namespace mpm
           if (material_names[m] == body.material)
             material_index = m;
         if (material_index == material_names.size())
-          fail(where + "Material", "'" + body.material + "' is not one of Materials/Names (" +
-                                     prm.get("Material") + " given; allowed: " +
+          fail(where + "Material", "'" + body.material + "' is not one of Materials/Names (allowed: " +
                                      join(material_names) + ").");
         if (body.shape == "polygon" && body.polygon.size() < 3)
           fail(where + "Polygon vertices", "a polygon needs at least 3 vertices, got " +

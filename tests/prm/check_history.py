@@ -1,0 +1,55 @@
+#!/usr/bin/python3
+"""Asserts properties of a dealii-mpm time history (history.csv).
+  --finite                    every value is finite
+  --conserved COL[,COL...]    the columns stay equal to their first value (relative --rtol)
+  --removed-at-least N        at least N points were removed (left the grid) by the end
+  (with --removed-at-least, also: the mass left is that of the points left)"""
+import argparse
+import os
+import sys
+
+import numpy as np
+
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "..", "scripts"))
+import mpm_results  # noqa: E402
+
+parser = argparse.ArgumentParser()
+parser.add_argument("output_dir")
+parser.add_argument("--finite", action="store_true")
+parser.add_argument("--conserved", default="")
+parser.add_argument("--rtol", type=float, default=1e-12)
+parser.add_argument("--removed-at-least", type=int, default=0)
+args = parser.parse_args()
+
+h = mpm_results.history(args.output_dir)
+failed = False
+if args.finite:
+    for key, values in h.items():
+        if not np.all(np.isfinite(values)):
+            print(f"FAILED: column {key} has non-finite values")
+            failed = True
+for key in filter(None, args.conserved.split(",")):
+    values = h[key]
+    scale = max(np.max(np.abs(values)), 1e-300)
+    if key.startswith("momentum"):  # components may nearly cancel: compare with |p| ~ sqrt(2 M E_kin)
+        scale = max(scale, np.max(np.sqrt(2 * h["total_mass"] * h["kinetic_energy"])))
+    drift = np.max(np.abs(values - values[0])) / scale
+    print(f"{key}: relative drift {drift:.3e} over {len(values)} rows (tolerance {args.rtol:.1e})")
+    if not drift <= args.rtol:
+        print(f"FAILED: {key} is not conserved")
+        failed = True
+if args.removed_at_least:
+    removed = int(h["n_removed"][-1])
+    print(f"points removed: {removed}, points left: {int(h['n_points'][-1])}")
+    if removed < args.removed_at_least:
+        print(f"FAILED: expected at least {args.removed_at_least} removed points")
+        failed = True
+    if int(h["n_points"][-1]) + removed != int(h["n_points"][0]):
+        print("FAILED: points left + removed != points at the start")
+        failed = True
+    # equal point masses here: the mass left is that of the points left
+    point_mass = h["total_mass"][0] / h["n_points"][0]
+    if abs(h["total_mass"][-1] - point_mass * h["n_points"][-1]) > 1e-12 * h["total_mass"][0]:
+        print("FAILED: the mass left does not match the points left")
+        failed = True
+sys.exit(1 if failed else 0)

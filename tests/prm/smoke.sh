@@ -1,0 +1,9 @@
+#!/bin/bash
+# Smoke test of a prm scene with a reduced number of steps: the run must succeed and
+# its history must be finite with the total mass conserved (no point leaves these scenes).
+set -eu
+exe=$1 prm=$2 out=$3 steps=$4 here=$(dirname "$0")
+bash "$here/run_scene.sh" "$exe" "$prm" "$out" 1 \
+  "subsection Solver" "  set Maximum number of steps = $steps" "end" \
+  "subsection Output" "  set History every n steps = 10" "end"
+/usr/bin/python3 "$here/check_history.py" "$out" --conserved total_mass --finite
