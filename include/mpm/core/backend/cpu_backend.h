@@ -18,8 +18,10 @@ namespace mpm
   {
     static constexpr const char *name = "cpu";
 
+    // MPM_HOST_DEVICE only so that nvcc accepts the step's __host__ __device__ lambdas
+    // instantiated with this backend in a .cu file; it only ever runs on the host.
     template <typename T>
-    static void add(T *target, const T value)
+    MPM_HOST_DEVICE static void add(T *target, const T value)
     {
       *target += value;
     }

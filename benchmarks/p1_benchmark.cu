@@ -1,0 +1,312 @@
+// Benchmark P1 of ../shared/BENCHMARKS.md on the CUDA backend: the 3D slump (ep2-3De's
+// performance scene), elastic phase (8 s of ramped gravity), 3D GIMP (cpGIMP, det F),
+// MUSL, pure FLIP, 8 points per cell, local damping 0.1, free-slip walls and base.
+// Linear elastic (Jaumann) stands in for Drucker-Prager until that model lands.
+// Generates the scene itself (no deal.II), runs the same step.h as the CPU, and prints per
+// size: points, cells, nodes, steps, wall s, point-updates/s, the bytes a step must move,
+// that traffic over the measured device-to-device copy bandwidth, and ep2-3De's MTP_eff.
+//
+// Usage: p1_benchmark [--fp32] [--sizes 20,160,640,2560] [--steps N] [--profile]
+//                     [--table FILE]
+//   --sizes   cells across (L_y / h): 20, 160, 640, 2560 give 100,240 ... 12,830,720 points
+//   --steps N stop after N steps instead of at 8 s (for sizes too large to run in full)
+//   --profile after the timed run, time each launch of 5 more steps (events per launch)
+//   --table   append the result rows (markdown) to FILE
+#include "p1_scene.h"
+
+#include <mpm/core/backend/cuda_backend.h>
+#include <mpm/core/backend/cuda_storage.h>
+#include <mpm/core/step.h>
+
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <string>
+#include <vector>
+
+using namespace mpm;
+using mpm_bench::P1;
+
+namespace
+{
+  struct Options
+  {
+    bool             fp32    = false;
+    bool             profile = false;
+    long             steps   = -1;
+    std::vector<int> sizes   = {20, 160, 640, 2560};
+    std::string      table;
+  };
+
+  // Device-to-device copy bandwidth, bytes read + bytes written per second.
+  double copy_bandwidth()
+  {
+    const size_t       bytes = size_t(2) << 30;
+    DeviceArray<char>  a(bytes), b(bytes);
+    a.fill_bytes(1);
+    cudaEvent_t start, stop;
+    MPM_CUDA_CHECK(cudaEventCreate(&start));
+    MPM_CUDA_CHECK(cudaEventCreate(&stop));
+    for (int i = 0; i < 3; ++i)
+      MPM_CUDA_CHECK(cudaMemcpyAsync(b.data(), a.data(), bytes, cudaMemcpyDeviceToDevice));
+    const int reps = 20;
+    MPM_CUDA_CHECK(cudaEventRecord(start));
+    for (int i = 0; i < reps; ++i)
+      MPM_CUDA_CHECK(cudaMemcpyAsync(i % 2 ? a.data() : b.data(), i % 2 ? b.data() : a.data(), bytes,
+                                     cudaMemcpyDeviceToDevice));
+    MPM_CUDA_CHECK(cudaEventRecord(stop));
+    MPM_CUDA_CHECK(cudaEventSynchronize(stop));
+    float ms = 0;
+    MPM_CUDA_CHECK(cudaEventElapsedTime(&ms, start, stop));
+    MPM_CUDA_CHECK(cudaEventDestroy(start));
+    MPM_CUDA_CHECK(cudaEventDestroy(stop));
+    return 2.0 * double(bytes) * reps / (ms * 1e-3);
+  }
+
+  // Fewest bytes one MUSL step of this implementation must move through device memory:
+  // every point array it reads, read once (position, velocity, mass, volume, V0, stress,
+  // strain, F, domain half-lengths and their initial values, plastic strain: 37 reals,
+  // and the material id), every one it writes, written once (position, velocity, volume,
+  // stress, strain, F, half-lengths, plastic strain: 32 reals), and the nodal arrays
+  // (mass, momentum, force, velocity: 10 reals) written once and read once, with the
+  // boundary mask and the lattice-to-node lookup read once.
+  template <typename Real>
+  double minimal_bytes_per_step(const double n_points, const double n_nodes)
+  {
+    return n_points * (69.0 * sizeof(Real) + sizeof(int)) + n_nodes * (20.0 * sizeof(Real) + 5.0);
+  }
+
+  const char *musl_launch_names[] = {"reset grid",        "P2G mass+momentum+forces", "grid update",
+                                     "G2P velocity",      "reset momentum",           "remap P2G momentum",
+                                     "nodal velocity",    "G2P kinematics+stress",    "reduction (dt)"};
+
+  template <typename Real>
+  bool run_size(const int n_cells_y, const Options &opt, const double bandwidth, FILE *table)
+  {
+    // Memory: points, grid, and a margin.
+    std::vector<double> xs, zs;
+    mpm_bench::p1_slice(xs, zs);
+    const double n_points_expected = double(xs.size()) * 2 * n_cells_y;
+    const double n_nodes_expected  = double(80 + 2 * P1::ghost + 1) * (n_cells_y + 2 * P1::ghost + 1) * (P1::cells_z + 1);
+    const double need = n_points_expected * DevicePoints<3, Real>::bytes_per_point() +
+                        n_nodes_expected * (10.0 * sizeof(Real) + 5.0);
+    size_t free_bytes = 0, total_bytes = 0;
+    MPM_CUDA_CHECK(cudaMemGetInfo(&free_bytes, &total_bytes));
+    if (need > 0.95 * double(free_bytes))
+      {
+        std::printf("| %d cells across: %.0f points need %.1f GB, %.1f GB free: does not fit |\n", n_cells_y,
+                    n_points_expected, need / 1e9, free_bytes / 1e9);
+        return false;
+      }
+
+    const auto          t0 = std::chrono::steady_clock::now();
+    HostGrid<3, Real>   grid;
+    HostPoints<3, Real> points;
+    std::vector<MaterialParameters<Real>> materials;
+    mpm_bench::make_p1(n_cells_y, grid, points, materials);
+    const int  n_points = points.size();
+    const long n_cells  = long(grid.n_cells[0]) * grid.n_cells[1] * grid.n_cells[2];
+    const int  n_nodes  = static_cast<int>(grid.mass.size());
+
+    DeviceGrid<3, Real>     dgrid;
+    DevicePoints<3, Real>   dpoints;
+    DeviceMaterials<Real>   dmaterials;
+    dgrid.upload(grid);
+    dpoints.upload(points);
+    dmaterials.upload(materials);
+    const double setup_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+
+    CudaBackend backend;
+    auto        gv = dgrid.view();
+    auto        pv = dpoints.view();
+    StepSettings<3, Real> s = mpm_bench::p1_settings<Real>();
+    const double          c = mpm_bench::p1_wave_speed();
+
+    // Warm-up (module load, first launches), then back to the initial state.
+    {
+      double max_speed = 0, t = 0;
+      for (int i = 0; i < 3; ++i)
+        {
+          const double dt = P1::cfl * P1::h / (c + max_speed);
+          mpm_bench::p1_gravity(s, t);
+          max_speed = explicit_step<3, GimpShape>(backend, gv, pv, dmaterials.data(), s, Real(dt)).max_speed;
+          t += dt;
+        }
+      dgrid.upload(grid);
+      dpoints.upload(points);
+      backend.synchronize();
+    }
+
+    cudaEvent_t start, stop;
+    MPM_CUDA_CHECK(cudaEventCreate(&start));
+    MPM_CUDA_CHECK(cudaEventCreate(&stop));
+    double max_speed = 0, t = 0;
+    long   steps     = 0;
+    const auto wall0 = std::chrono::steady_clock::now();
+    MPM_CUDA_CHECK(cudaEventRecord(start, backend.get_stream()));
+    while (t < P1::t_end - 1e-9 && (opt.steps < 0 || steps < opt.steps))
+      {
+        const double dt = P1::cfl * P1::h / (c + max_speed);
+        mpm_bench::p1_gravity(s, t);
+        max_speed = explicit_step<3, GimpShape>(backend, gv, pv, dmaterials.data(), s, Real(dt)).max_speed;
+        t += dt;
+        ++steps;
+      }
+    MPM_CUDA_CHECK(cudaEventRecord(stop, backend.get_stream()));
+    MPM_CUDA_CHECK(cudaEventSynchronize(stop));
+    const double host_wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+    float        ms        = 0;
+    MPM_CUDA_CHECK(cudaEventElapsedTime(&ms, start, stop));
+    MPM_CUDA_CHECK(cudaEventDestroy(start));
+    MPM_CUDA_CHECK(cudaEventDestroy(stop));
+    const double wall = ms * 1e-3;
+
+    // Sanity of the physics: no point lost or NaN; the deepest vertical stress against
+    // the lithostatic rho g H of the 12.2 m column (gravity fully on after 5.33 s).
+    HostPoints<3, Real> result;
+    dpoints.download(result);
+    int    removed = 0, non_finite = 0;
+    double min_szz = 0, max_speed_end = 0;
+    for (int i = 0; i < n_points; ++i)
+      {
+        if (result.material[i] < 0)
+          ++removed;
+        if (!std::isfinite(double(result.stress[2][i])) || !std::isfinite(double(result.position[2][i])))
+          ++non_finite;
+        min_szz = std::min(min_szz, double(result.stress[2][i]));
+        double v2 = 0;
+        for (int d = 0; d < 3; ++d)
+          v2 += double(result.velocity[d][i]) * result.velocity[d][i];
+        max_speed_end = std::max(max_speed_end, std::sqrt(v2));
+      }
+
+    const double updates  = double(n_points) * steps / wall;
+    const double bytes    = minimal_bytes_per_step<Real>(n_points, n_nodes);
+    const double fraction = bytes * steps / wall / bandwidth;
+    const double n_io     = 2.0 * n_points * (43 + 22 * 64) + 26.0 * n_nodes + 2.0 * n_cells;
+    const double mtp_eff  = steps * n_io * sizeof(Real) / (1024.0 * 1024.0 * 1024.0 * wall);
+    std::printf("| %s | %d | %ld | %d | %ld | %.3f | %.3e | %.1f | %.1f MB | %.3f | %.0f | %.3f | %.2f | %d | %d | %.3g |\n",
+                sizeof(Real) == 8 ? "FP64" : "FP32", n_points, n_cells, n_nodes, steps, wall, updates,
+                wall / steps * 1e3, bytes / 1e6, fraction, mtp_eff, host_wall, setup_s, removed, non_finite,
+                -min_szz / (P1::rho * P1::gravity * 12.23));
+    std::fflush(stdout);
+    if (table != nullptr)
+      {
+        std::fprintf(table, "| %s | %d | %ld | %ld | %.3f | %.2e | %.2f | %.0f | %.3f | %.0f |\n",
+                     sizeof(Real) == 8 ? "FP64" : "FP32", n_points, n_cells, steps, wall, updates,
+                     wall / steps * 1e3, bytes / n_points, fraction, mtp_eff);
+        std::fflush(table);
+      }
+    if (removed > 0 || non_finite > 0)
+      std::printf("WARNING: %d points removed, %d non-finite\n", removed, non_finite);
+
+    if (opt.profile)
+      {
+        backend.enable_kernel_timing(true);
+        const int          n_prof = 5;
+        std::vector<double> sum(9, 0.0);
+        for (int i = 0; i < n_prof; ++i)
+          {
+            const double dt = P1::cfl * P1::h / (c + max_speed);
+            max_speed = explicit_step<3, GimpShape>(backend, gv, pv, dmaterials.data(), s, Real(dt)).max_speed;
+            const std::vector<float> times = backend.kernel_times_ms();
+            for (size_t k = 0; k < times.size() && k < sum.size(); ++k)
+              sum[k] += times[k];
+          }
+        backend.enable_kernel_timing(false);
+        double total = 0;
+        for (double v : sum)
+          total += v;
+        std::printf("  per-launch times, %s, %d points (mean of %d steps; sum %.3f ms/step vs %.3f ms/step timed):\n",
+                    sizeof(Real) == 8 ? "FP64" : "FP32", n_points, n_prof, total / n_prof, wall / steps * 1e3);
+        for (size_t k = 0; k < sum.size(); ++k)
+          std::printf("    %-26s %8.3f ms  %5.1f%%\n", musl_launch_names[k], sum[k] / n_prof, 100 * sum[k] / total);
+        if (table != nullptr)
+          {
+            std::fprintf(table, "\nPer-launch times, %s, %d points, ms per step (mean of %d steps):\n\n",
+                         sizeof(Real) == 8 ? "FP64" : "FP32", n_points, n_prof);
+            std::fprintf(table, "| launch | ms | share |\n|---|---|---|\n");
+            for (size_t k = 0; k < sum.size(); ++k)
+              std::fprintf(table, "| %s | %.3f | %.1f%% |\n", musl_launch_names[k], sum[k] / n_prof,
+                           100 * sum[k] / total);
+            std::fprintf(table, "\n");
+          }
+      }
+    return true;
+  }
+} // namespace
+
+int main(int argc, char **argv)
+{
+  Options opt;
+  for (int i = 1; i < argc; ++i)
+    {
+      const std::string a = argv[i];
+      if (a == "--fp32")
+        opt.fp32 = true;
+      else if (a == "--profile")
+        opt.profile = true;
+      else if (a == "--steps" && i + 1 < argc)
+        opt.steps = std::atol(argv[++i]);
+      else if (a == "--table" && i + 1 < argc)
+        opt.table = argv[++i];
+      else if (a == "--sizes" && i + 1 < argc)
+        {
+          opt.sizes.clear();
+          std::string list = argv[++i];
+          size_t      pos  = 0;
+          while (pos < list.size())
+            {
+              const size_t next = list.find(',', pos);
+              opt.sizes.push_back(std::atoi(list.substr(pos, next - pos).c_str()));
+              pos = next == std::string::npos ? list.size() : next + 1;
+            }
+        }
+      else
+        {
+          std::printf("usage: %s [--fp32] [--sizes 20,160,640,2560] [--steps N] [--profile] [--table FILE]\n", argv[0]);
+          return 2;
+        }
+    }
+  if (cuda_device_count() == 0)
+    {
+      std::printf("p1_benchmark: no CUDA device found\n");
+      return 77;
+    }
+  try
+    {
+      cudaDeviceProp prop;
+      MPM_CUDA_CHECK(cudaGetDeviceProperties(&prop, 0));
+      size_t free_bytes = 0, total_bytes = 0;
+      MPM_CUDA_CHECK(cudaMemGetInfo(&free_bytes, &total_bytes));
+      const double bandwidth = copy_bandwidth();
+      std::printf("device: %s, %d SMs, %.1f GB (%.1f GB free), L2 %.0f MB; device-to-device copy %.0f GB/s "
+                  "(read + write)\n",
+                  prop.name, prop.multiProcessorCount, total_bytes / 1e9, free_bytes / 1e9, prop.l2CacheSize / 1e6,
+                  bandwidth / 1e9);
+      const double per_point = opt.fp32 ? DevicePoints<3, float>::bytes_per_point() : DevicePoints<3, double>::bytes_per_point();
+      std::printf("scene P1 (elastic phase, linear elastic stand-in for Drucker-Prager), %s; device memory per point "
+                  "%.0f B: about %.0f M points would fit\n",
+                  opt.fp32 ? "FP32" : "FP64", per_point, 0.9 * free_bytes / (per_point * 1.1) / 1e6);
+      std::printf("| prec | points | cells | nodes | steps | wall s | point-updates/s | ms/step | min bytes/step | "
+                  "fraction of copy BW | MTP_eff GB/s | host wall s | setup s | removed | non-finite | "
+                  "max|szz|/(rho g 12.23 m) |\n");
+      std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+      FILE *table = opt.table.empty() ? nullptr : std::fopen(opt.table.c_str(), "a");
+      for (const int n : opt.sizes)
+        {
+          if (opt.fp32)
+            run_size<float>(n, opt, bandwidth, table);
+          else
+            run_size<double>(n, opt, bandwidth, table);
+        }
+      if (table != nullptr)
+        std::fclose(table);
+    }
+  catch (const std::exception &e)
+    {
+      std::printf("p1_benchmark: %s\n", e.what());
+      return 1;
+    }
+  return 0;
+}

@@ -1,0 +1,246 @@
+// Device twins of HostPoints / HostGrid (host_storage.h): the same arrays in device
+// memory (cudaMalloc), filled by upload() from the host owners, copied back by
+// download() only when the host must see them (output, tests), and handing out the
+// same GridView / PointsView the step works on. Every CUDA call is checked.
+//
+// Include from .cu files only (needs nvcc) or from host code linked with cudart.
+#pragma once
+
+#include <mpm/core/backend/cuda_check.h>
+#include <mpm/core/host_storage.h>
+#include <mpm/core/material/material.h>
+
+#include <cuda_runtime.h>
+
+#include <cstddef>
+#include <cstdint>
+#include <utility>
+#include <vector>
+
+namespace mpm
+{
+  // An owning device array of trivially copyable T.
+  template <typename T>
+  class DeviceArray
+  {
+  public:
+    DeviceArray() = default;
+    explicit DeviceArray(const size_t n) { resize(n); }
+    DeviceArray(const DeviceArray &)            = delete;
+    DeviceArray &operator=(const DeviceArray &) = delete;
+    DeviceArray(DeviceArray &&other) noexcept { swap(other); }
+    DeviceArray &operator=(DeviceArray &&other) noexcept
+    {
+      swap(other);
+      return *this;
+    }
+    ~DeviceArray() { cudaFree(ptr); } // no throwing from a destructor
+
+    void resize(const size_t new_size)
+    {
+      if (new_size == n)
+        return;
+      if (ptr != nullptr)
+        MPM_CUDA_CHECK(cudaFree(ptr));
+      ptr = nullptr;
+      n   = new_size;
+      if (n > 0)
+        MPM_CUDA_CHECK(cudaMalloc(&ptr, n * sizeof(T)));
+    }
+
+    void upload(const std::vector<T> &host)
+    {
+      resize(host.size());
+      if (n > 0)
+        MPM_CUDA_CHECK(cudaMemcpy(ptr, host.data(), n * sizeof(T), cudaMemcpyHostToDevice));
+    }
+
+    void download(std::vector<T> &host) const
+    {
+      host.resize(n);
+      if (n > 0)
+        MPM_CUDA_CHECK(cudaMemcpy(host.data(), ptr, n * sizeof(T), cudaMemcpyDeviceToHost));
+    }
+
+    // Every byte set to `byte` (poisoning in tests, zeroing).
+    void fill_bytes(const int byte)
+    {
+      if (n > 0)
+        MPM_CUDA_CHECK(cudaMemset(ptr, byte, n * sizeof(T)));
+    }
+
+    T      *data() { return ptr; }
+    const T *data() const { return ptr; }
+    size_t size() const { return n; }
+    size_t bytes() const { return n * sizeof(T); }
+
+  private:
+    T     *ptr = nullptr;
+    size_t n   = 0;
+
+    void swap(DeviceArray &other) noexcept
+    {
+      std::swap(ptr, other.ptr);
+      std::swap(n, other.n);
+    }
+  };
+
+  template <int dim, typename Real>
+  struct DevicePoints
+  {
+    DeviceArray<Real> position[dim], velocity[dim], mass, volume, initial_volume, stress[n_voigt], strain[n_voigt],
+      deformation_gradient[dim * dim], domain_half_length[dim], initial_domain_half_length[dim], plastic_strain;
+    DeviceArray<int> material;
+
+    int size() const { return static_cast<int>(mass.size()); }
+
+    void upload(const HostPoints<dim, Real> &h)
+    {
+      for (int d = 0; d < dim; ++d)
+        {
+          position[d].upload(h.position[d]);
+          velocity[d].upload(h.velocity[d]);
+          domain_half_length[d].upload(h.domain_half_length[d]);
+          initial_domain_half_length[d].upload(h.initial_domain_half_length[d]);
+        }
+      for (int c = 0; c < n_voigt; ++c)
+        {
+          stress[c].upload(h.stress[c]);
+          strain[c].upload(h.strain[c]);
+        }
+      for (int c = 0; c < dim * dim; ++c)
+        deformation_gradient[c].upload(h.deformation_gradient[c]);
+      mass.upload(h.mass);
+      volume.upload(h.volume);
+      initial_volume.upload(h.initial_volume);
+      plastic_strain.upload(h.plastic_strain);
+      material.upload(h.material);
+    }
+
+    void download(HostPoints<dim, Real> &h) const
+    {
+      for (int d = 0; d < dim; ++d)
+        {
+          position[d].download(h.position[d]);
+          velocity[d].download(h.velocity[d]);
+          domain_half_length[d].download(h.domain_half_length[d]);
+          initial_domain_half_length[d].download(h.initial_domain_half_length[d]);
+        }
+      for (int c = 0; c < n_voigt; ++c)
+        {
+          stress[c].download(h.stress[c]);
+          strain[c].download(h.strain[c]);
+        }
+      for (int c = 0; c < dim * dim; ++c)
+        deformation_gradient[c].download(h.deformation_gradient[c]);
+      mass.download(h.mass);
+      volume.download(h.volume);
+      initial_volume.download(h.initial_volume);
+      plastic_strain.download(h.plastic_strain);
+      material.download(h.material);
+    }
+
+    // Bytes of device memory held per point.
+    static constexpr size_t bytes_per_point()
+    {
+      return (4 * dim + 4 + 2 * n_voigt + dim * dim) * sizeof(Real) + sizeof(int);
+    }
+
+    PointsView<dim, Real> view()
+    {
+      PointsView<dim, Real> v;
+      v.n_points = size();
+      for (int d = 0; d < dim; ++d)
+        {
+          v.position[d]                   = position[d].data();
+          v.velocity[d]                   = velocity[d].data();
+          v.domain_half_length[d]         = domain_half_length[d].data();
+          v.initial_domain_half_length[d] = initial_domain_half_length[d].data();
+        }
+      for (int c = 0; c < n_voigt; ++c)
+        {
+          v.stress[c] = stress[c].data();
+          v.strain[c] = strain[c].data();
+        }
+      for (int c = 0; c < dim * dim; ++c)
+        v.deformation_gradient[c] = deformation_gradient[c].data();
+      v.mass           = mass.data();
+      v.volume         = volume.data();
+      v.initial_volume = initial_volume.data();
+      v.plastic_strain = plastic_strain.data();
+      v.material       = material.data();
+      return v;
+    }
+  };
+
+  template <int dim, typename Real>
+  struct DeviceGrid
+  {
+    Real                      origin[dim];
+    Real                      h = 0;
+    int                       n_cells[dim];
+    DeviceArray<int>          lattice_to_node;
+    DeviceArray<Real>         mass, momentum[dim], force[dim], velocity[dim];
+    DeviceArray<std::uint8_t> fixed_components;
+
+    int n_nodes() const { return static_cast<int>(mass.size()); }
+
+    // Geometry, lookup, masks and the current nodal values.
+    void upload(const HostGrid<dim, Real> &g)
+    {
+      h = g.h;
+      for (int d = 0; d < dim; ++d)
+        {
+          origin[d]  = g.origin[d];
+          n_cells[d] = g.n_cells[d];
+          momentum[d].upload(g.momentum[d]);
+          force[d].upload(g.force[d]);
+          velocity[d].upload(g.velocity[d]);
+        }
+      lattice_to_node.upload(g.lattice_to_node);
+      mass.upload(g.mass);
+      fixed_components.upload(g.fixed_components);
+    }
+
+    // Nodal values back to the host (tests, output).
+    void download_nodal(HostGrid<dim, Real> &g) const
+    {
+      for (int d = 0; d < dim; ++d)
+        {
+          momentum[d].download(g.momentum[d]);
+          force[d].download(g.force[d]);
+          velocity[d].download(g.velocity[d]);
+        }
+      mass.download(g.mass);
+    }
+
+    GridView<dim, Real> view()
+    {
+      GridView<dim, Real> v;
+      for (int d = 0; d < dim; ++d)
+        {
+          v.origin[d]   = origin[d];
+          v.n_cells[d]  = n_cells[d];
+          v.momentum[d] = momentum[d].data();
+          v.force[d]    = force[d].data();
+          v.velocity[d] = velocity[d].data();
+        }
+      v.h                = h;
+      v.lattice_to_node  = lattice_to_node.data();
+      v.n_nodes          = n_nodes();
+      v.mass             = mass.data();
+      v.fixed_components = fixed_components.data();
+      return v;
+    }
+  };
+
+  // The material table the constitutive update indexes by p.material[i].
+  template <typename Real>
+  struct DeviceMaterials
+  {
+    DeviceArray<MaterialParameters<Real>> table;
+
+    void upload(const std::vector<MaterialParameters<Real>> &materials) { table.upload(materials); }
+    const MaterialParameters<Real> *data() const { return table.data(); }
+  };
+} // namespace mpm

@@ -1,0 +1,66 @@
+#!/usr/bin/env bash
+# On the GPU machine (CUDA, CMake, python3; no deal.II): configure the compute core with the
+# CUDA backend, build, run the core and gpu ctest labels, compute-sanitizer on a small scene,
+# and the P1 benchmark; everything goes to $OUT (default ./output-gpu), the benchmark table
+# to $OUT/p1_table.md. Run from the repository root:
+#   scripts/gpu_run.sh [quick]      quick: benchmark sizes up to 3.2M points only
+set -u -o pipefail
+ROOT=$(cd "$(dirname "$0")/.." && pwd)
+OUT=${OUT:-$ROOT/output-gpu}
+BUILD=${BUILD:-/tmp/build-gpu}
+MODE=${1:-full}
+mkdir -p "$OUT"
+export PATH=/usr/local/cuda/bin:$PATH
+status=0
+
+{
+  date -u +"%Y-%m-%d %H:%M UTC"
+  nvidia-smi --query-gpu=name,driver_version,memory.total,clocks.max.sm,clocks.max.mem --format=csv
+  nvcc --version | tail -2
+  cmake --version | head -1
+} 2>&1 | tee "$OUT/machine.txt"
+
+GEN=""
+command -v ninja >/dev/null && GEN="-G Ninja"
+cmake -S "$ROOT" -B "$BUILD" $GEN -DMPM_CORE_ONLY=ON -DMPM_WITH_CUDA=ON -DCMAKE_BUILD_TYPE=Release \
+  >"$OUT/build.log" 2>&1 || { tail -30 "$OUT/build.log"; exit 1; }
+cmake --build "$BUILD" -j "$(nproc)" >>"$OUT/build.log" 2>&1 || { tail -40 "$OUT/build.log"; exit 1; }
+echo "build: ok"
+
+(cd "$BUILD" && ctest -L "core|gpu" --output-on-failure -j 4 2>&1) | tee "$OUT/ctest.log" || status=1
+# the gpu tests print their numbers; keep them
+for t in test_gpu_physics test_gpu_transfer_conservation test_gpu_elastic_column test_gpu_cpu_agreement; do
+  echo "== $t" >>"$OUT/gpu_tests.log"
+  "$BUILD/tests/gpu/$t" >>"$OUT/gpu_tests.log" 2>&1 || true
+done
+grep -E "GPU-CPU|device|FAILED|passed|cells|^ +[0-9]+ " "$OUT/gpu_tests.log" | head -40
+
+B="$BUILD/benchmarks/p1_benchmark"
+if command -v compute-sanitizer >/dev/null; then
+  # small scene: P1 with 2 cells across (10,024 points), 20 steps
+  compute-sanitizer --tool memcheck --leak-check full "$B" --sizes 2 --steps 20 >"$OUT/memcheck.log" 2>&1 || status=1
+  compute-sanitizer --tool racecheck "$B" --sizes 2 --steps 5 >"$OUT/racecheck.log" 2>&1 || status=1
+  echo "memcheck:  $(grep -E 'ERROR SUMMARY|LEAK SUMMARY' "$OUT/memcheck.log" | tr '\n' ' ')"
+  echo "racecheck: $(grep -E 'RACECHECK SUMMARY|ERROR SUMMARY' "$OUT/racecheck.log" | tr '\n' ' ')"
+else
+  echo "compute-sanitizer: not found"
+fi
+
+T="$OUT/p1_table.md"
+{
+  echo "P1 (elastic phase, linear elastic stand-in for Drucker-Prager), CUDA backend, $(head -1 "$OUT/machine.txt")"
+  echo
+  echo "| prec | points | cells | steps | wall s | point-updates/s | ms/step | min bytes/point/step | fraction of copy BW | MTP_eff GB/s |"
+  echo "|---|---|---|---|---|---|---|---|---|---|"
+} >"$T"
+if [ "$MODE" = quick ]; then
+  "$B" --sizes 20,160,640 --profile --table "$T" 2>&1 | tee "$OUT/bench.log" || status=1
+else
+  "$B" --sizes 20,160,640,2560 --profile --table "$T" 2>&1 | tee "$OUT/bench.log" || status=1
+  "$B" --fp32 --sizes 20,2560 --profile --table "$T" 2>&1 | tee -a "$OUT/bench.log" || status=1
+  # larger than the published sizes, a fixed number of steps
+  "$B" --sizes 10240 --steps 60 --table "$T" 2>&1 | tee -a "$OUT/bench.log" || status=1
+fi
+echo
+cat "$T"
+exit $status

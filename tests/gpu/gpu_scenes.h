@@ -1,0 +1,181 @@
+// Scene drivers shared by the GPU tests, templated on a Target (gpu_targets.h) so that the
+// CPU and GPU runs of one scene execute the same host code around the same step.h.
+//   column  : V1 of ../shared/BENCHMARKS.md (2D, GIMP, MUSL, elastic column, ramped gravity)
+//   slump   : P1/V5 slump geometry, reduced to 2 cells across (3D, GIMP, 10,024 points),
+//             elastic, gravity ramp, local damping 0.1, free-slip walls and base
+//   collapse: V3 geometry (2D, 0.2 m x 0.1 m column against a wall), h = 5 mm, 2x2 ppc,
+//             elastic until the Drucker-Prager model lands; no-slip base, rollers on walls,
+//             gravity applied at once
+#pragma once
+
+#include "../../benchmarks/p1_scene.h"
+#include "gpu_targets.h"
+
+#include <mpm/core/point_generation.h>
+
+#include <cmath>
+#include <vector>
+
+namespace mpm_test
+{
+  struct SceneResult
+  {
+    long   n_steps = 0;
+    double time    = 0;
+    double error   = 0; // column: the V1 error norm (full runs only)
+  };
+
+  // V1 column as tests/core/elastic_column.h sets it up. max_steps < 0: run to 2 t_ramp.
+  template <typename Shape, template <int, typename> class Target>
+  SceneResult column(const int n_cells, mpm::HostPoints<2, double> &points, const long max_steps,
+                     const mpm::HostPoints<2, double> *initial = nullptr,
+                     const mpm::DomainUpdate domain_update = mpm::DomainUpdate::stretch, const double damping = 0.05)
+  {
+    using namespace mpm;
+    const double l0 = 10, E = 1e4, rho = 80, g = 9.81, cfl = 0.5;
+    const double c = std::sqrt(E / rho), t_ramp = 40 * l0 / c, t_end = 2 * t_ramp, h = l0 / n_cells;
+    HostGrid<2, double> grid;
+    const double        lower[2] = {0, 0};
+    const int           cells[2] = {1, n_cells};
+    grid.make_dense(lower, h, cells);
+    for (long n = 0; n < long(grid.lattice_to_node.size()); ++n)
+      {
+        int idx[2];
+        grid.lattice_coordinates(n, idx);
+        grid.fixed_components[n] = 1u | (idx[1] == 0 ? 2u : 0u);
+      }
+    points = HostPoints<2, double>();
+    BodyDescription<2, double> body{2, rho, {0, 0}, 0};
+    const double               hi[2] = {h, l0};
+    add_points(points, grid, lower, hi, body, [](const double *) { return true; });
+    if (initial != nullptr)
+      points = *initial;
+    const std::vector<double> y0 = points.position[1];
+    MaterialParameters<double> m;
+    m.model                  = MaterialModel::linear_elastic;
+    m.elastic.youngs_modulus = E;
+    m.elastic.poissons_ratio = 0;
+
+    StepSettings<2, double> s;
+    s.scheme         = UpdateScheme::musl;
+    s.gravity[0]     = 0;
+    s.damping        = damping;
+    s.flip_fraction  = 1.0;
+    s.domain_update  = domain_update;
+    s.mass_tolerance = 1e-12 * points.mass[0];
+
+    Target<2, double> target(grid, points, {m});
+    auto              gv = target.grid();
+    auto              pv = target.points();
+    SceneResult       r;
+    double            max_speed = 0;
+    while (r.time < t_end - 1e-12 * t_end && (max_steps < 0 || r.n_steps < max_steps))
+      {
+        double dt = cfl * h / (c + max_speed);
+        if (r.time + dt > t_end)
+          dt = t_end - r.time;
+        s.gravity[1] = -g * std::min(1.0, r.time / t_ramp);
+        max_speed    = explicit_step<2, Shape>(target.backend, gv, pv, target.material_table(), s, dt).max_speed;
+        r.time += dt;
+        ++r.n_steps;
+      }
+    target.finish();
+    double V0 = 0;
+    for (int i = 0; i < points.size(); ++i)
+      {
+        r.error += std::abs(points.stress[1][i] + rho * g * (l0 - y0[i])) * points.initial_volume[i];
+        V0 += points.initial_volume[i];
+      }
+    r.error /= rho * g * l0 * V0;
+    return r;
+  }
+
+  // P1 slump geometry, n_cells_y cells across, elastic phase, fixed number of steps.
+  template <template <int, typename> class Target, typename Real = double>
+  SceneResult slump(const int n_cells_y, mpm::HostPoints<3, Real> &points, const long n_steps,
+                    const mpm::HostPoints<3, Real> *initial = nullptr, const double damping = mpm_bench::P1::damping)
+  {
+    using namespace mpm;
+    using mpm_bench::P1;
+    HostGrid<3, Real>                     grid;
+    std::vector<MaterialParameters<Real>> materials;
+    mpm_bench::make_p1(n_cells_y, grid, points, materials);
+    if (initial != nullptr)
+      points = *initial; // same scene, points given (e.g. reordered)
+    StepSettings<3, Real> s = mpm_bench::p1_settings<Real>();
+    s.damping               = Real(damping);
+    const double          c = mpm_bench::p1_wave_speed();
+    Target<3, Real>       target(grid, points, materials);
+    auto                  gv = target.grid();
+    auto                  pv = target.points();
+    SceneResult           r;
+    double                max_speed = 0;
+    for (; r.n_steps < n_steps; ++r.n_steps)
+      {
+        const double dt = P1::cfl * P1::h / (c + max_speed);
+        mpm_bench::p1_gravity(s, r.time);
+        max_speed = explicit_step<3, GimpShape>(target.backend, gv, pv, target.material_table(), s, Real(dt)).max_speed;
+        r.time += dt;
+      }
+    target.finish();
+    return r;
+  }
+
+  // V3 geometry (2D), elastic, gravity at once.
+  template <template <int, typename> class Target>
+  SceneResult collapse(mpm::HostPoints<2, double> &points, const long n_steps,
+                       const mpm::HostPoints<2, double> *initial = nullptr)
+  {
+    using namespace mpm;
+    const double h = 0.005, rho = 2650, E = 0.84e6, nu = 0.3, g = 9.81, cfl = 0.5;
+    const double length = 0.5, height = 0.15;
+    HostGrid<2, double> grid;
+    const double        lower[2] = {-2 * h, -2 * h};
+    const int           cells[2] = {int(std::lround(length / h)) + 4, int(std::lround(height / h)) + 2};
+    grid.make_dense(lower, h, cells);
+    for (long n = 0; n < long(grid.lattice_to_node.size()); ++n)
+      {
+        int idx[2];
+        grid.lattice_coordinates(n, idx);
+        std::uint8_t mask = 0;
+        if (idx[0] <= 2 || idx[0] >= cells[0] - 2)
+          mask |= 1u; // rollers on the walls
+        if (idx[1] <= 2)
+          mask |= 3u; // no-slip base
+        grid.fixed_components[n] = mask;
+      }
+    points = HostPoints<2, double>();
+    BodyDescription<2, double> body{2, rho, {0, 0}, 0};
+    const double               lo[2] = {0, 0}, hi[2] = {0.2, 0.1};
+    add_points(points, grid, lo, hi, body, [](const double *) { return true; });
+    if (initial != nullptr)
+      points = *initial;
+    MaterialParameters<double> m;
+    m.model                  = MaterialModel::linear_elastic;
+    m.elastic.youngs_modulus = E;
+    m.elastic.poissons_ratio = nu;
+    const double c = std::sqrt(m.elastic.p_wave_modulus() / rho);
+
+    StepSettings<2, double> s;
+    s.scheme         = UpdateScheme::musl;
+    s.gravity[0]     = 0;
+    s.gravity[1]     = -g;
+    s.damping        = 0;
+    s.flip_fraction  = 1.0;
+    s.domain_update  = DomainUpdate::det_F;
+    s.mass_tolerance = 1e-12 * points.mass[0];
+    Target<2, double> target(grid, points, {m});
+    auto              gv = target.grid();
+    auto              pv = target.points();
+    SceneResult       r;
+    double            max_speed = 0;
+    for (; r.n_steps < n_steps; ++r.n_steps)
+      {
+        const double dt = cfl * h / (c + max_speed);
+        max_speed = explicit_step<2, GimpShape>(target.backend, gv, pv, target.material_table(), s, dt).max_speed;
+        r.time += dt;
+      }
+    target.finish();
+    return r;
+  }
+} // namespace mpm_test

@@ -1,0 +1,169 @@
+// Run the same scene driver on the CPU or on the GPU: a Target owns the storage its
+// backend needs and hands out the views; finish() brings the points (and nodal values)
+// back into the host owners. Scene drivers are templated on the Target, so the CPU and
+// GPU runs of a comparison execute the same host code around the same step.h.
+#pragma once
+
+#include <mpm/core/backend/cpu_backend.h>
+#include <mpm/core/backend/cuda_backend.h>
+#include <mpm/core/backend/cuda_storage.h>
+#include <mpm/core/host_storage.h>
+#include <mpm/core/step.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <vector>
+
+namespace mpm_test
+{
+  // Exit code ctest reads as "skipped" (SKIP_RETURN_CODE 77 in tests/gpu/CMakeLists.txt).
+  constexpr int skip_code = 77;
+
+  // Prints the device, or returns false where there is none (the test then exits 77).
+  inline bool cuda_device_present(const char *test_name)
+  {
+    if (mpm::cuda_device_count() == 0)
+      {
+        std::printf("%s: no CUDA device found, skipping\n", test_name);
+        return false;
+      }
+    cudaDeviceProp prop;
+    MPM_CUDA_CHECK(cudaGetDeviceProperties(&prop, 0));
+    std::printf("%s: device %s (sm_%d%d, %d SMs)\n", test_name, prop.name, prop.major, prop.minor,
+                prop.multiProcessorCount);
+    return true;
+  }
+
+  template <int dim, typename Real>
+  struct CpuTarget
+  {
+    static constexpr const char *name = "cpu";
+    mpm::HostGrid<dim, Real>                   &host_grid;
+    mpm::HostPoints<dim, Real>                 &host_points;
+    std::vector<mpm::MaterialParameters<Real>> materials;
+    mpm::CpuBackend                             backend;
+
+    CpuTarget(mpm::HostGrid<dim, Real> &g, mpm::HostPoints<dim, Real> &p,
+              const std::vector<mpm::MaterialParameters<Real>> &m)
+      : host_grid(g)
+      , host_points(p)
+      , materials(m)
+    {}
+    mpm::GridView<dim, Real>         grid() { return host_grid.view(); }
+    mpm::PointsView<dim, Real>       points() { return host_points.view(); }
+    const mpm::MaterialParameters<Real> *material_table() const { return materials.data(); }
+    void                             finish() {}
+  };
+
+  template <int dim, typename Real>
+  struct CudaTarget
+  {
+    static constexpr const char *name = "cuda";
+    mpm::HostGrid<dim, Real>     &host_grid;
+    mpm::HostPoints<dim, Real>   &host_points;
+    mpm::DeviceGrid<dim, Real>    device_grid;
+    mpm::DevicePoints<dim, Real>  device_points;
+    mpm::DeviceMaterials<Real>    device_materials;
+    mpm::CudaBackend              backend;
+
+    CudaTarget(mpm::HostGrid<dim, Real> &g, mpm::HostPoints<dim, Real> &p,
+               const std::vector<mpm::MaterialParameters<Real>> &m)
+      : host_grid(g)
+      , host_points(p)
+    {
+      device_grid.upload(g);
+      device_points.upload(p);
+      device_materials.upload(m);
+    }
+    mpm::GridView<dim, Real>             grid() { return device_grid.view(); }
+    mpm::PointsView<dim, Real>           points() { return device_points.view(); }
+    const mpm::MaterialParameters<Real> *material_table() const { return device_materials.data(); }
+    void                                 finish()
+    {
+      backend.synchronize();
+      device_points.download(host_points);
+      device_grid.download_nodal(host_grid);
+    }
+  };
+
+  // Per-point differences between two runs of one scene, each field scaled by a
+  // magnitude of that field over the whole reference run (a per-component relative
+  // error is meaningless where the component passes through zero):
+  // positions by the cell size h, velocities by max |v|, stresses by max |sigma|.
+  struct Difference
+  {
+    double position = 0, velocity = 0, stress = 0;
+    int    removed_mismatch = 0;
+    double worst() const
+    {
+      double w = position > velocity ? position : velocity;
+      return w > stress ? w : stress;
+    }
+  };
+
+  template <int dim, typename Real>
+  Difference compare_points(const mpm::HostPoints<dim, Real> &ref, const mpm::HostPoints<dim, Real> &other,
+                            const double h)
+  {
+    Difference diff;
+    double     v_scale = 0, s_scale = 0;
+    for (int i = 0; i < ref.size(); ++i)
+      {
+        for (int d = 0; d < dim; ++d)
+          v_scale = std::max(v_scale, std::abs(double(ref.velocity[d][i])));
+        for (int c = 0; c < mpm::n_voigt; ++c)
+          s_scale = std::max(s_scale, std::abs(double(ref.stress[c][i])));
+      }
+    if (v_scale == 0)
+      v_scale = 1;
+    if (s_scale == 0)
+      s_scale = 1;
+    for (int i = 0; i < ref.size(); ++i)
+      {
+        if ((ref.material[i] < 0) != (other.material[i] < 0))
+          ++diff.removed_mismatch;
+        for (int d = 0; d < dim; ++d)
+          {
+            diff.position = std::max(diff.position, std::abs(double(ref.position[d][i] - other.position[d][i])) / h);
+            diff.velocity = std::max(diff.velocity, std::abs(double(ref.velocity[d][i] - other.velocity[d][i])) / v_scale);
+          }
+        for (int c = 0; c < mpm::n_voigt; ++c)
+          diff.stress = std::max(diff.stress, std::abs(double(ref.stress[c][i] - other.stress[c][i])) / s_scale);
+        // NaN anywhere makes the comparison fail
+        for (int d = 0; d < dim; ++d)
+          if (!std::isfinite(double(other.position[d][i])) || !std::isfinite(double(other.velocity[d][i])))
+            diff.position = diff.velocity = INFINITY;
+      }
+    return diff;
+  }
+
+  // Reverse the order of the points (changes the order of every nodal sum on the CPU).
+  template <int dim, typename Real>
+  mpm::HostPoints<dim, Real> reversed(const mpm::HostPoints<dim, Real> &p)
+  {
+    mpm::HostPoints<dim, Real> r = p;
+    auto flip = [](auto &v) { std::reverse(v.begin(), v.end()); };
+    for (int d = 0; d < dim; ++d)
+      {
+        flip(r.position[d]);
+        flip(r.velocity[d]);
+        flip(r.domain_half_length[d]);
+        flip(r.initial_domain_half_length[d]);
+      }
+    for (int c = 0; c < mpm::n_voigt; ++c)
+      {
+        flip(r.stress[c]);
+        flip(r.strain[c]);
+      }
+    for (int c = 0; c < dim * dim; ++c)
+      flip(r.deformation_gradient[c]);
+    flip(r.mass);
+    flip(r.volume);
+    flip(r.initial_volume);
+    flip(r.plastic_strain);
+    flip(r.material);
+    return r;
+  }
+} // namespace mpm_test

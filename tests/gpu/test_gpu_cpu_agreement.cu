@@ -1,0 +1,104 @@
+// CPU vs GPU on the same scenes after a fixed number of steps, per point, FP64.
+//
+// Why not bitwise: the GPU adds the nodal contributions with atomicAdd in an order that
+// changes from run to run, and nvcc contracts a*b+c into one fused multiply-add where the
+// host rounds twice. Both change results at the level of the unit round-off u = 2^-53.
+//
+// Tolerance. A nodal sum of K contributions computed in another order differs by at most
+// (K-1) u sum|terms| (Higham, ch. 4). With GIMP and 2 points per direction per cell a node
+// receives from points within h + l_p < 1.5 h on each side, 5 points per direction:
+// K <= 25 in 2D, 125 in 3D. Each step perturbs the nodal momenta and forces by K u relative
+// to the size of their terms (for forces: of the stress-divergence terms, which nearly
+// cancel in a quasi-static state, hence the scaling by max |sigma| and max |v| below, not
+// by the local value). A stable explicit step of an elastic body under CFL carries such
+// perturbations without amplifying them, so after N steps they add up to at most about
+// N K u: 1000 steps x 25 x 1.1e-16 = 2.8e-12 (2D), 300 x 125 x 1.1e-16 = 4.2e-12 (3D).
+// We allow 1e-10: 25-35 times that bound, for the conditioning factor of the force sums
+// and the few operations each value passes through per step, and still 5 orders of
+// magnitude below any physical effect. The same sensitivity is measured on the CPU alone
+// by running each scene with the points in reverse order (every nodal sum reordered):
+// the GPU must not differ from the CPU by much more than that (printed, checked within
+// 100x of it where it is not zero).
+// Local damping is the exception: f <- f - D |f| sign(v) is discontinuous where a nodal
+// velocity passes through zero, and a node whose velocity is zero up to round-off (a
+// symmetry plane, a wall-adjacent node) gets +-D|f| depending on the summation order.
+// Measured on the CPU alone with the slump scene (D = 0.1, 300 steps): reordering the
+// points changes velocities by 8e-9 of max |v| (4e-14 with D = 0). So the scenes run
+// without damping are held to 1e-10, and the damped ones (column D = 0.05, slump D = 0.1)
+// to max(1e-10, 100 x the CPU's own reordering spread).
+// Only GIMP is compared: its weights are C1 in the point position, so a perturbation of a
+// position changes the weights by as much; standard MPM's gradients jump at cell faces.
+#include "../core/check.h"
+#include "gpu_scenes.h"
+
+using namespace mpm;
+using namespace mpm_test;
+
+constexpr double tolerance = 1e-10;
+
+template <int dim>
+void report(const char *scene, const Difference &gpu, const Difference &reordered, const long steps,
+            const bool damped)
+{
+  std::printf("%-34s %6ld steps | GPU-CPU: x/h %.1e v %.1e sigma %.1e | CPU reordered: x/h %.1e v %.1e sigma %.1e\n",
+              scene, steps, gpu.position, gpu.velocity, gpu.stress, reordered.position, reordered.velocity,
+              reordered.stress);
+  const double      limit = damped ? std::max(tolerance, 100 * reordered.worst()) : tolerance;
+  const std::string what  = std::string(scene) + (damped ? ": GPU vs CPU within max(1e-10, 100x CPU reordering)" :
+                                                           ": GPU vs CPU per point within 1e-10");
+  check_below(gpu.worst(), limit, what.c_str());
+  check(gpu.removed_mismatch == 0, (std::string(scene) + ": same points removed").c_str());
+}
+
+int main()
+{
+  if (!cuda_device_present("test_gpu_cpu_agreement"))
+    return skip_code;
+  try
+    {
+      {
+        // V1 column, 32 cells, 1000 steps (the ramp has started, points have moved)
+        const long          n = 1000;
+        HostPoints<2, double> cpu, rev, gpu, initial;
+        column<GimpShape, CpuTarget>(32, initial, 0);
+        column<GimpShape, CpuTarget>(32, cpu, n, &initial);
+        const HostPoints<2, double> initial_rev = reversed(initial);
+        column<GimpShape, CpuTarget>(32, rev, n, &initial_rev);
+        column<GimpShape, CudaTarget>(32, gpu, n, &initial);
+        report<2>("V1 column 32 cells (2D GIMP)", compare_points(cpu, gpu, 10.0 / 32),
+                  compare_points(cpu, reversed(rev), 10.0 / 32), n, true);
+      }
+      {
+        // V3 geometry, elastic, 600 steps of gravity applied at once
+        const long            n = 600;
+        HostPoints<2, double> cpu, rev, gpu, initial;
+        collapse<CpuTarget>(initial, 0);
+        collapse<CpuTarget>(cpu, n, &initial);
+        const HostPoints<2, double> initial_rev = reversed(initial);
+        collapse<CpuTarget>(rev, n, &initial_rev);
+        collapse<CudaTarget>(gpu, n, &initial);
+        report<2>("V3 collapse geometry, elastic (2D)", compare_points(cpu, gpu, 0.005),
+                  compare_points(cpu, reversed(rev), 0.005), n, false);
+      }
+      for (const double damping : {0.0, mpm_bench::P1::damping})
+        {
+          // P1/V5 slump geometry, 2 cells across (10,024 points), 200 steps
+          const long            n = 200;
+          HostPoints<3, double> cpu, rev, gpu, initial;
+          slump<CpuTarget>(2, initial, 0);
+          slump<CpuTarget>(2, cpu, n, &initial, damping);
+          const HostPoints<3, double> initial_rev = reversed(initial);
+          slump<CpuTarget>(2, rev, n, &initial_rev, damping);
+          slump<CudaTarget>(2, gpu, n, &initial, damping);
+          report<3>(damping > 0 ? "P1/V5 slump 2 cells across, D=0.1" : "P1/V5 slump 2 cells across, D=0",
+                    compare_points(cpu, gpu, mpm_bench::P1::h), compare_points(cpu, reversed(rev), mpm_bench::P1::h),
+                    n, damping > 0);
+        }
+    }
+  catch (const std::exception &e)
+    {
+      std::printf("exception: %s\n", e.what());
+      return 1;
+    }
+  return finish("test_gpu_cpu_agreement");
+}
