@@ -35,6 +35,8 @@ namespace mpm
 
       PointTotals<dim, double> totals() override { return point_totals<dim>(backend, points.view()); }
 
+      void set_materials(const std::vector<MaterialParameters<double>> &m) override { materials = m; }
+
     private:
       BackgroundGrid<dim>                    &grid;
       std::vector<MaterialParameters<double>> materials;

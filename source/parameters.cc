@@ -123,6 +123,9 @@ namespace mpm
                       "Gravitational acceleration vector (m/s^2).");
     prm.declare_entry("Gravity ramp time", "0", Patterns::Double(0),
                       "Gravity grows linearly from 0 to its full value over this time (s); 0 = applied at once.");
+    prm.declare_entry("Plasticity start time", "0", Patterns::Double(0),
+                      "Plastic models behave elastically before this time (s), so that the geostatic stress "
+                      "settles under gravity before failure can start; 0 = plastic from the start.");
     prm.declare_entry("Maximum number of steps", "0", Patterns::Integer(0),
                       "Stop after this many steps even before End time; 0 = no limit.");
     prm.leave_subsection();
@@ -250,6 +253,7 @@ namespace mpm
     gravity           = get_point(prm, "Gravity");
     gravity_ramp_time = prm.get_double("Gravity ramp time");
     max_steps         = prm.get_integer("Maximum number of steps");
+    plasticity_start_time = prm.get_double("Plasticity start time");
     prm.leave_subsection();
 
     prm.enter_subsection("Materials");

@@ -68,7 +68,12 @@ namespace mpm
     AssertThrow(n_points_initial > 0,
                 dealii::ExcMessage("Parameter 'Material points': the bodies contain no material point (each body "
                                    "must cover at least one point site of the grid)."));
-    auto engine = make_engine<dim>(parameters.backend, grid, parameters.materials, parameters.shape_function);
+    // Before the plasticity start time every model behaves elastically.
+    std::vector<MaterialParameters<double>> materials = parameters.materials;
+    bool plastic = !(parameters.plasticity_start_time > 0);
+    for (auto &m : materials)
+      m.plasticity_enabled = plastic;
+    auto engine = make_engine<dim>(parameters.backend, grid, materials, parameters.shape_function);
     engine->load(points);
     OutputWriter<dim> output(parameters, communicator);
     timer.leave_subsection();
@@ -133,6 +138,15 @@ namespace mpm
         const double ramp = parameters.gravity_ramp_time > 0 ? std::min(1.0, time / parameters.gravity_ramp_time) : 1.0;
         for (int d = 0; d < dim; ++d)
           settings.gravity[d] = ramp * parameters.gravity[d];
+
+        if (!plastic && time >= parameters.plasticity_start_time)
+          {
+            plastic = true;
+            for (auto &m : materials)
+              m.plasticity_enabled = true;
+            engine->set_materials(materials);
+            pcout << "  plasticity switched on at t = " << time << " s" << std::endl;
+          }
 
         StepReduction<double> r;
         {

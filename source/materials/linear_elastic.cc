@@ -1,7 +1,6 @@
 // "linear elastic": Hooke's law in Jaumann rate form (include/mpm/core/material/linear_elastic.h).
 #include <mpm/dealii/material_library.h>
-
-#include <deal.II/base/exceptions.h>
+#include <mpm/dealii/strength_parameters.h>
 
 namespace mpm
 {
@@ -9,23 +8,14 @@ namespace mpm
   {
     void declare(dealii::ParameterHandler &prm)
     {
-      using dealii::Patterns::Double;
-      prm.declare_entry("Young's modulus", "1e6", Double(0), "Young's modulus E in Pa (> 0).");
-      prm.declare_entry("Poisson's ratio", "0.3", Double(-1, 0.5), "Poisson's ratio nu, -1 < nu < 0.5.");
+      declare_elastic_parameters(prm);
     }
 
     MaterialParameters<double> parse(dealii::ParameterHandler &prm)
     {
       MaterialParameters<double> m{};
-      m.model                  = MaterialModel::linear_elastic;
-      m.elastic.youngs_modulus = prm.get_double("Young's modulus");
-      m.elastic.poissons_ratio = prm.get_double("Poisson's ratio");
-      AssertThrow(m.elastic.youngs_modulus > 0,
-                  dealii::ExcMessage("Entry 'Young's modulus' must be > 0, got " +
-                                     prm.get("Young's modulus") + "."));
-      AssertThrow(m.elastic.poissons_ratio > -1 && m.elastic.poissons_ratio < 0.5,
-                  dealii::ExcMessage("Entry 'Poisson's ratio' must lie in (-1, 0.5), got " +
-                                     prm.get("Poisson's ratio") + "."));
+      m.model   = MaterialModel::linear_elastic;
+      m.elastic = parse_elastic_parameters(prm);
       return m;
     }
   } // namespace

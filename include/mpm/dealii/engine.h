@@ -23,6 +23,8 @@ namespace mpm
     virtual unsigned int            store(MaterialPoints<dim> &points)                = 0;
     virtual StepReduction<double>   step(const StepSettings<dim, double> &s, double dt) = 0;
     virtual PointTotals<dim, double> totals()                                         = 0;
+    // Replaces the material table (e.g. when plasticity is switched on).
+    virtual void set_materials(const std::vector<MaterialParameters<double>> &materials) = 0;
   };
 
   // Throws naming Backend/Backend if the requested backend is not available.

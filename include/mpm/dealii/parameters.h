@@ -56,6 +56,7 @@ namespace mpm
     double       flip_fraction;
     std::vector<double> gravity;
     double       gravity_ramp_time;
+    double       plasticity_start_time;
     unsigned int max_steps;
 
     // Materials, in the order of their names; bodies refer to them by index.

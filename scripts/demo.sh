@@ -1,0 +1,9 @@
+#!/bin/bash
+# Fresh Debian 12, as root: install, build, run the default scene (V1 elastic column, 2D).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bash scripts/setup.sh
+mkdir -p results && cd results
+../build/dealii-mpm ../prm/elastic_column_2d.prm
+/usr/bin/python3 ../scripts/column_error.py output-elastic-column-2d
+echo "Results are in $(pwd)/output-elastic-column-2d (open particles.pvd in ParaView)."

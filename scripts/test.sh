@@ -1,0 +1,8 @@
+#!/bin/bash
+# Fresh Debian 12, as root: install, build, run the test suite (GPU tests skip without a GPU).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bash scripts/setup.sh
+export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
+cd build
+ctest -j "$(nproc)" --output-on-failure --timeout 900
