@@ -12,13 +12,20 @@
 //   --steps N stop after N steps instead of at 8 s (for sizes too large to run in full)
 //   --profile after the timed run, time each launch of 5 more steps (events per launch)
 //   --table   append the result rows (markdown) to FILE
+//   --order   generated (y-slice, then z rows, then x: the order ep2-3De's setup makes),
+//             cell (sorted by cell index, x fastest: what sorting by cell would give),
+//             random (shuffled: the worst case for the atomic scatter)
+//   --block N threads per block of the point and node loops (default 256)
 #include "p1_scene.h"
 
 #include <mpm/core/backend/cuda_backend.h>
 #include <mpm/core/backend/cuda_storage.h>
 #include <mpm/core/step.h>
 
+#include <algorithm>
 #include <chrono>
+#include <random>
+#include <stdexcept>
 #include <cstdio>
 #include <cstring>
 #include <string>
@@ -36,7 +43,69 @@ namespace
     long             steps   = -1;
     std::vector<int> sizes   = {20, 160, 640, 2560};
     std::string      table;
+    std::string      order = "generated";
+    int              block = 256;
   };
+
+  // Reorder every point array by perm (new point i is old point perm[i]).
+  template <typename Real>
+  void permute(HostPoints<3, Real> &p, const std::vector<int> &perm)
+  {
+    auto apply = [&](auto &v) {
+      auto copy = v;
+      for (size_t i = 0; i < perm.size(); ++i)
+        v[i] = copy[perm[i]];
+    };
+    for (int d = 0; d < 3; ++d)
+      {
+        apply(p.position[d]);
+        apply(p.velocity[d]);
+        apply(p.domain_half_length[d]);
+        apply(p.initial_domain_half_length[d]);
+      }
+    for (int c = 0; c < n_voigt; ++c)
+      {
+        apply(p.stress[c]);
+        apply(p.strain[c]);
+      }
+    for (int c = 0; c < 9; ++c)
+      apply(p.deformation_gradient[c]);
+    apply(p.mass);
+    apply(p.volume);
+    apply(p.initial_volume);
+    apply(p.plastic_strain);
+    apply(p.material);
+  }
+
+  template <typename Real>
+  void reorder(HostPoints<3, Real> &p, const HostGrid<3, Real> &g, const std::string &order)
+  {
+    if (order == "generated")
+      return;
+    std::vector<int> perm(p.size());
+    for (int i = 0; i < p.size(); ++i)
+      perm[i] = i;
+    if (order == "random")
+      {
+        std::mt19937 rng(1);
+        std::shuffle(perm.begin(), perm.end(), rng);
+      }
+    else if (order == "cell")
+      {
+        std::vector<long> cell(p.size());
+        for (int i = 0; i < p.size(); ++i)
+          {
+            long c = 0;
+            for (int d = 2; d >= 0; --d)
+              c = c * g.n_cells[d] + static_cast<long>(std::floor((p.position[d][i] - g.origin[d]) / g.h));
+            cell[i] = c;
+          }
+        std::stable_sort(perm.begin(), perm.end(), [&](int a, int b) { return cell[a] < cell[b]; });
+      }
+    else
+      throw std::runtime_error("unknown --order " + order);
+    permute(p, perm);
+  }
 
   // Device-to-device copy bandwidth, bytes read + bytes written per second.
   double copy_bandwidth()
@@ -104,6 +173,7 @@ namespace
     HostPoints<3, Real> points;
     std::vector<MaterialParameters<Real>> materials;
     mpm_bench::make_p1(n_cells_y, grid, points, materials);
+    reorder(points, grid, opt.order);
     const int  n_points = points.size();
     const long n_cells  = long(grid.n_cells[0]) * grid.n_cells[1] * grid.n_cells[2];
     const int  n_nodes  = static_cast<int>(grid.mass.size());
@@ -117,6 +187,7 @@ namespace
     const double setup_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
     CudaBackend backend;
+    backend.block_size = opt.block;
     auto        gv = dgrid.view();
     auto        pv = dpoints.view();
     StepSettings<3, Real> s = mpm_bench::p1_settings<Real>();
@@ -180,20 +251,25 @@ namespace
         max_speed_end = std::max(max_speed_end, std::sqrt(v2));
       }
 
+    std::string label = sizeof(Real) == 8 ? "FP64" : "FP32";
+    if (opt.order != "generated")
+      label += ", " + opt.order + " order";
+    if (opt.block != 256)
+      label += ", block " + std::to_string(opt.block);
     const double updates  = double(n_points) * steps / wall;
     const double bytes    = minimal_bytes_per_step<Real>(n_points, n_nodes);
     const double fraction = bytes * steps / wall / bandwidth;
     const double n_io     = 2.0 * n_points * (43 + 22 * 64) + 26.0 * n_nodes + 2.0 * n_cells;
     const double mtp_eff  = steps * n_io * sizeof(Real) / (1024.0 * 1024.0 * 1024.0 * wall);
     std::printf("| %s | %d | %ld | %d | %ld | %.3f | %.3e | %.1f | %.1f MB | %.3f | %.0f | %.3f | %.2f | %d | %d | %.3g |\n",
-                sizeof(Real) == 8 ? "FP64" : "FP32", n_points, n_cells, n_nodes, steps, wall, updates,
+                label.c_str(), n_points, n_cells, n_nodes, steps, wall, updates,
                 wall / steps * 1e3, bytes / 1e6, fraction, mtp_eff, host_wall, setup_s, removed, non_finite,
                 -min_szz / (P1::rho * P1::gravity * 12.23));
     std::fflush(stdout);
     if (table != nullptr)
       {
         std::fprintf(table, "| %s | %d | %ld | %ld | %.3f | %.2e | %.2f | %.0f | %.3f | %.0f |\n",
-                     sizeof(Real) == 8 ? "FP64" : "FP32", n_points, n_cells, steps, wall, updates,
+                     label.c_str(), n_points, n_cells, steps, wall, updates,
                      wall / steps * 1e3, bytes / n_points, fraction, mtp_eff);
         std::fflush(table);
       }
@@ -248,6 +324,10 @@ int main(int argc, char **argv)
         opt.profile = true;
       else if (a == "--steps" && i + 1 < argc)
         opt.steps = std::atol(argv[++i]);
+      else if (a == "--order" && i + 1 < argc)
+        opt.order = argv[++i];
+      else if (a == "--block" && i + 1 < argc)
+        opt.block = std::atoi(argv[++i]);
       else if (a == "--table" && i + 1 < argc)
         opt.table = argv[++i];
       else if (a == "--sizes" && i + 1 < argc)
@@ -264,7 +344,9 @@ int main(int argc, char **argv)
         }
       else
         {
-          std::printf("usage: %s [--fp32] [--sizes 20,160,640,2560] [--steps N] [--profile] [--table FILE]\n", argv[0]);
+          std::printf("usage: %s [--fp32] [--sizes 20,160,640,2560] [--steps N] [--profile] [--table FILE]\n"
+                      "          [--order generated|cell|random] [--block N]\n",
+                      argv[0]);
           return 2;
         }
     }
@@ -285,9 +367,10 @@ int main(int argc, char **argv)
                   prop.name, prop.multiProcessorCount, total_bytes / 1e9, free_bytes / 1e9, prop.l2CacheSize / 1e6,
                   bandwidth / 1e9);
       const double per_point = opt.fp32 ? DevicePoints<3, float>::bytes_per_point() : DevicePoints<3, double>::bytes_per_point();
-      std::printf("scene P1 (elastic phase, linear elastic stand-in for Drucker-Prager), %s; device memory per point "
-                  "%.0f B: about %.0f M points would fit\n",
-                  opt.fp32 ? "FP32" : "FP64", per_point, 0.9 * free_bytes / (per_point * 1.1) / 1e6);
+      std::printf("scene P1 (elastic phase, linear elastic stand-in for Drucker-Prager), %s, point order %s, %d "
+                  "threads per block; device memory per point %.0f B: about %.0f M points would fit\n",
+                  opt.fp32 ? "FP32" : "FP64", opt.order.c_str(), opt.block, per_point,
+                  0.9 * free_bytes / (per_point * 1.1) / 1e6);
       std::printf("| prec | points | cells | nodes | steps | wall s | point-updates/s | ms/step | min bytes/step | "
                   "fraction of copy BW | MTP_eff GB/s | host wall s | setup s | removed | non-finite | "
                   "max|szz|/(rho g 12.23 m) |\n");
