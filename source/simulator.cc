@@ -59,6 +59,11 @@ namespace mpm
     dealii::TimerOutput timer(communicator, pcout, dealii::TimerOutput::summary, dealii::TimerOutput::wall_times);
     const auto wall_start = std::chrono::steady_clock::now();
 
+    // Points do not yet migrate between ranks during the step loop (the MPI issue):
+    // refuse rather than compute wrong results.
+    AssertThrow(dealii::Utilities::MPI::n_mpi_processes(communicator) == 1,
+                dealii::ExcMessage("Runs on more than one MPI rank are not supported yet: run with one rank."));
+
     // Set-up: grid, material points, engine, output.
     timer.enter_subsection("setup");
     BackgroundGrid<dim> grid(parameters, communicator);
