@@ -55,14 +55,23 @@ namespace mpm
   template <int dim>
   void Simulator<dim>::run()
   {
-    dealii::ConditionalOStream pcout(std::cout, dealii::Utilities::MPI::this_mpi_process(communicator) == 0);
-    dealii::TimerOutput timer(communicator, pcout, dealii::TimerOutput::summary, dealii::TimerOutput::wall_times);
-    const auto wall_start = std::chrono::steady_clock::now();
-
     // Points do not yet migrate between ranks during the step loop (the MPI issue):
     // refuse rather than compute wrong results.
     AssertThrow(dealii::Utilities::MPI::n_mpi_processes(communicator) == 1,
                 dealii::ExcMessage("Runs on more than one MPI rank are not supported yet: run with one rank."));
+
+    const double c_el = elastic_wave_speed(parameters);
+    const double h    = parameters.cell_size;
+    if (!parameters.adaptive_time_step)
+      AssertThrow(parameters.fixed_time_step * c_el <= h,
+                  dealii::ExcMessage("Parameter 'Solver/Fixed time step': " +
+                                     dealii::Utilities::to_string(parameters.fixed_time_step) +
+                                     " s exceeds the elastic stability limit h / c_el = " +
+                                     dealii::Utilities::to_string(h / c_el) + " s (CFL > 1)."));
+
+    dealii::ConditionalOStream pcout(std::cout, dealii::Utilities::MPI::this_mpi_process(communicator) == 0);
+    dealii::TimerOutput timer(communicator, pcout, dealii::TimerOutput::summary, dealii::TimerOutput::wall_times);
+    const auto wall_start = std::chrono::steady_clock::now();
 
     // Set-up: grid, material points, engine, output.
     timer.enter_subsection("setup");
@@ -83,14 +92,6 @@ namespace mpm
     OutputWriter<dim> output(parameters, communicator);
     timer.leave_subsection();
 
-    const double c_el = elastic_wave_speed(parameters);
-    const double h    = parameters.cell_size;
-    if (!parameters.adaptive_time_step)
-      AssertThrow(parameters.fixed_time_step * c_el <= h,
-                  dealii::ExcMessage("Parameter 'Solver/Fixed time step': " +
-                                     dealii::Utilities::to_string(parameters.fixed_time_step) +
-                                     " s exceeds the elastic stability limit h / c_el = " +
-                                     dealii::Utilities::to_string(h / c_el) + " s (CFL > 1)."));
     pcout << "dealii-mpm: " << dim << "D, " << grid.triangulation.n_global_active_cells() << " cells, "
           << grid.dof_handler.n_dofs() << " nodes, " << n_points_initial << " material points, "
           << dealii::Utilities::MPI::n_mpi_processes(communicator) << " MPI rank(s), backend "
