@@ -15,7 +15,7 @@
 //   --order   generated (y-slice, then z rows, then x: the order ep2-3De's setup makes),
 //             cell (sorted by cell index, x fastest: what sorting by cell would give),
 //             random (shuffled: the worst case for the atomic scatter)
-//   --block N threads per block of the point and node loops (default 256)
+//   --block N threads per block of the point and node loops (default 128)
 #include "p1_scene.h"
 
 #include <mpm/core/backend/cuda_backend.h>
@@ -44,7 +44,7 @@ namespace
     std::vector<int> sizes   = {20, 160, 640, 2560};
     std::string      table;
     std::string      order = "generated";
-    int              block = 256;
+    int              block = 128;
   };
 
   // Reorder every point array by perm (new point i is old point perm[i]).
@@ -254,7 +254,7 @@ namespace
     std::string label = sizeof(Real) == 8 ? "FP64" : "FP32";
     if (opt.order != "generated")
       label += ", " + opt.order + " order";
-    if (opt.block != 256)
+    if (opt.block != 128)
       label += ", block " + std::to_string(opt.block);
     const double updates  = double(n_points) * steps / wall;
     const double bytes    = minimal_bytes_per_step<Real>(n_points, n_nodes);
