@@ -17,7 +17,8 @@ parser = argparse.ArgumentParser()
 parser.add_argument("output_dir")
 parser.add_argument("--finite", action="store_true")
 parser.add_argument("--conserved", default="")
-parser.add_argument("--rtol", type=float, default=1e-12)
+parser.add_argument("--rtol", default="1e-12",
+                    help="relative tolerance, or 'auto': n_points * 2.2e-16, the round-off bound of a sum over the points in any order")
 parser.add_argument("--removed-at-least", type=int, default=0)
 args = parser.parse_args()
 
@@ -28,14 +29,15 @@ if args.finite:
         if not np.all(np.isfinite(values)):
             print(f"FAILED: column {key} has non-finite values")
             failed = True
+rtol = max(1e-14, h["n_points"][0] * 2.2e-16) if args.rtol == "auto" else float(args.rtol)
 for key in filter(None, args.conserved.split(",")):
     values = h[key]
     scale = max(np.max(np.abs(values)), 1e-300)
     if key.startswith("momentum"):  # components may nearly cancel: compare with |p| ~ sqrt(2 M E_kin)
         scale = max(scale, np.max(np.sqrt(2 * h["total_mass"] * h["kinetic_energy"])))
     drift = np.max(np.abs(values - values[0])) / scale
-    print(f"{key}: relative drift {drift:.3e} over {len(values)} rows (tolerance {args.rtol:.1e})")
-    if not drift <= args.rtol:
+    print(f"{key}: relative drift {drift:.3e} over {len(values)} rows (tolerance {rtol:.1e})")
+    if not drift <= rtol:
         print(f"FAILED: {key} is not conserved")
         failed = True
 if args.removed_at_least:
