@@ -1,6 +1,6 @@
 // Scene drivers shared by the GPU tests, templated on a Target (gpu_targets.h) so that the
 // CPU and GPU runs of one scene execute the same host code around the same step.h.
-//   column  : V1 of ../shared/BENCHMARKS.md (2D, GIMP, MUSL, elastic column, ramped gravity)
+//   column  : tests/core/elastic_column.h (V1, shared with the CPU tests)
 //   slump   : P1/V5 slump geometry, reduced to 2 cells across (3D, GIMP, 10,024 points),
 //             elastic, gravity ramp, local damping 0.1, free-slip walls and base
 //   collapse: V3 geometry (2D, 0.2 m x 0.1 m column against a wall), h = 5 mm, 2x2 ppc,
@@ -9,6 +9,7 @@
 #pragma once
 
 #include "../../benchmarks/p1_scene.h"
+#include "../core/elastic_column.h"
 #include "gpu_targets.h"
 
 #include <mpm/core/point_generation.h>
@@ -24,71 +25,6 @@ namespace mpm_test
     double time    = 0;
     double error   = 0; // column: the V1 error norm (full runs only)
   };
-
-  // V1 column as tests/core/elastic_column.h sets it up. max_steps < 0: run to 2 t_ramp.
-  template <typename Shape, template <int, typename> class Target>
-  SceneResult column(const int n_cells, mpm::HostPoints<2, double> &points, const long max_steps,
-                     const mpm::HostPoints<2, double> *initial = nullptr,
-                     const mpm::DomainUpdate domain_update = mpm::DomainUpdate::stretch, const double damping = 0.05)
-  {
-    using namespace mpm;
-    const double l0 = 10, E = 1e4, rho = 80, g = 9.81, cfl = 0.5;
-    const double c = std::sqrt(E / rho), t_ramp = 40 * l0 / c, t_end = 2 * t_ramp, h = l0 / n_cells;
-    HostGrid<2, double> grid;
-    const double        lower[2] = {0, 0};
-    const int           cells[2] = {1, n_cells};
-    grid.make_dense(lower, h, cells);
-    for (long n = 0; n < long(grid.lattice_to_node.size()); ++n)
-      {
-        int idx[2];
-        grid.lattice_coordinates(n, idx);
-        grid.fixed_components[n] = 1u | (idx[1] == 0 ? 2u : 0u);
-      }
-    points = HostPoints<2, double>();
-    BodyDescription<2, double> body{2, rho, {0, 0}, 0};
-    const double               hi[2] = {h, l0};
-    add_points(points, grid, lower, hi, body, [](const double *) { return true; });
-    if (initial != nullptr)
-      points = *initial;
-    const std::vector<double> y0 = points.position[1];
-    MaterialParameters<double> m;
-    m.model                  = MaterialModel::linear_elastic;
-    m.elastic.youngs_modulus = E;
-    m.elastic.poissons_ratio = 0;
-
-    StepSettings<2, double> s;
-    s.scheme         = UpdateScheme::musl;
-    s.gravity[0]     = 0;
-    s.damping        = damping;
-    s.flip_fraction  = 1.0;
-    s.domain_update  = domain_update;
-    s.mass_tolerance = 1e-12 * points.mass[0];
-
-    Target<2, double> target(grid, points, {m});
-    auto              gv = target.grid();
-    auto              pv = target.points();
-    SceneResult       r;
-    double            max_speed = 0;
-    while (r.time < t_end - 1e-12 * t_end && (max_steps < 0 || r.n_steps < max_steps))
-      {
-        double dt = cfl * h / (c + max_speed);
-        if (r.time + dt > t_end)
-          dt = t_end - r.time;
-        s.gravity[1] = -g * std::min(1.0, r.time / t_ramp);
-        max_speed    = explicit_step<2, Shape>(target.backend, gv, pv, target.material_table(), s, dt).max_speed;
-        r.time += dt;
-        ++r.n_steps;
-      }
-    target.finish();
-    double V0 = 0;
-    for (int i = 0; i < points.size(); ++i)
-      {
-        r.error += std::abs(points.stress[1][i] + rho * g * (l0 - y0[i])) * points.initial_volume[i];
-        V0 += points.initial_volume[i];
-      }
-    r.error /= rho * g * l0 * V0;
-    return r;
-  }
 
   // P1 slump geometry, n_cells_y cells across, elastic phase, fixed number of steps.
   template <template <int, typename> class Target, typename Real = double>

@@ -1,10 +1,9 @@
-// Run the same scene driver on the CPU or on the GPU: a Target owns the storage its
-// backend needs and hands out the views; finish() brings the points (and nodal values)
-// back into the host owners. Scene drivers are templated on the Target, so the CPU and
-// GPU runs of a comparison execute the same host code around the same step.h.
+// The GPU Target (CudaTarget) beside the CPU one of tests/core/targets.h, and helpers to
+// compare a CPU and a GPU run of one scene point by point.
 #pragma once
 
-#include <mpm/core/backend/cpu_backend.h>
+#include "../core/targets.h"
+
 #include <mpm/core/backend/cuda_backend.h>
 #include <mpm/core/backend/cuda_storage.h>
 #include <mpm/core/host_storage.h>
@@ -35,27 +34,6 @@ namespace mpm_test
                 prop.multiProcessorCount);
     return true;
   }
-
-  template <int dim, typename Real>
-  struct CpuTarget
-  {
-    static constexpr const char *name = "cpu";
-    mpm::HostGrid<dim, Real>                   &host_grid;
-    mpm::HostPoints<dim, Real>                 &host_points;
-    std::vector<mpm::MaterialParameters<Real>> materials;
-    mpm::CpuBackend                             backend;
-
-    CpuTarget(mpm::HostGrid<dim, Real> &g, mpm::HostPoints<dim, Real> &p,
-              const std::vector<mpm::MaterialParameters<Real>> &m)
-      : host_grid(g)
-      , host_points(p)
-      , materials(m)
-    {}
-    mpm::GridView<dim, Real>         grid() { return host_grid.view(); }
-    mpm::PointsView<dim, Real>       points() { return host_points.view(); }
-    const mpm::MaterialParameters<Real> *material_table() const { return materials.data(); }
-    void                             finish() {}
-  };
 
   template <int dim, typename Real>
   struct CudaTarget

@@ -60,11 +60,14 @@ int main()
         // V1 column, 32 cells, 1000 steps (the ramp has started, points have moved)
         const long          n = 1000;
         HostPoints<2, double> cpu, rev, gpu, initial;
-        column<GimpShape, CpuTarget>(32, initial, 0);
-        column<GimpShape, CpuTarget>(32, cpu, n, &initial);
+        ColumnSetup setup{32};
+        setup.max_steps = 0;
+        elastic_column<GimpShape, CpuTarget>(setup, initial);
+        setup.max_steps = n;
+        elastic_column<GimpShape, CpuTarget>(setup, cpu, &initial);
         const HostPoints<2, double> initial_rev = reversed(initial);
-        column<GimpShape, CpuTarget>(32, rev, n, &initial_rev);
-        column<GimpShape, CudaTarget>(32, gpu, n, &initial);
+        elastic_column<GimpShape, CpuTarget>(setup, rev, &initial_rev);
+        elastic_column<GimpShape, CudaTarget>(setup, gpu, &initial);
         report<2>("V1 column 32 cells (2D GIMP)", compare_points(cpu, gpu, 10.0 / 32),
                   compare_points(cpu, reversed(rev), 10.0 / 32), n, true);
       }
