@@ -16,7 +16,13 @@ namespace mpm
         : grid(grid)
         , materials(materials)
         , shape(shape)
-      {}
+      {
+        long n_cells = 1;
+        for (int d = 0; d < dim; ++d)
+          n_cells *= grid.n_cells[d];
+        cell_volume.assign(n_cells, 0.);
+        cell_pressure_volume.assign(n_cells, 0.);
+      }
 
       void load(const MaterialPoints<dim> &p) override { p.copy_to(points); }
 
@@ -29,8 +35,10 @@ namespace mpm
 
       StepReduction<double> step(const StepSettings<dim, double> &s, const double dt) override
       {
-        return explicit_step<dim>(backend, shape, grid.view(), points.view(), materials.data(), s, dt,
-                                  grid.exchange());
+        GridView<dim, double> g  = grid.view();
+        g.cell_volume            = cell_volume.data();
+        g.cell_pressure_volume   = cell_pressure_volume.data();
+        return explicit_step<dim>(backend, shape, g, points.view(), materials.data(), s, dt, grid.exchange());
       }
 
       PointTotals<dim, double> totals() override { return point_totals<dim>(backend, points.view()); }
@@ -43,6 +51,7 @@ namespace mpm
       ShapeFunction                           shape;
       CpuBackend                              backend;
       HostPoints<dim, double>                 points;
+      std::vector<double>                     cell_volume, cell_pressure_volume; // pressure-averaging scratch
     };
   } // namespace
 

@@ -126,6 +126,10 @@ namespace mpm
     prm.declare_entry("Plasticity start time", "0", Patterns::Double(0),
                       "Plastic models behave elastically before this time (s), so that the geostatic stress "
                       "settles under gravity before failure can start; 0 = plastic from the start.");
+    prm.declare_entry("Pressure averaging", "false", Patterns::Bool(),
+                      "true: after the constitutive update every point of a grid cell gets the volume-weighted "
+                      "mean pressure of the points in that cell (deviatoric stress kept), against volumetric "
+                      "locking, as in ep2-3De. false: no averaging.");
     prm.declare_entry("Maximum number of steps", "0", Patterns::Integer(0),
                       "Stop after this many steps even before End time; 0 = no limit.");
     prm.leave_subsection();
@@ -254,6 +258,7 @@ namespace mpm
     gravity_ramp_time = prm.get_double("Gravity ramp time");
     max_steps         = prm.get_integer("Maximum number of steps");
     plasticity_start_time = prm.get_double("Plasticity start time");
+    pressure_averaging    = prm.get_bool("Pressure averaging");
     prm.leave_subsection();
 
     prm.enter_subsection("Materials");

@@ -104,6 +104,7 @@ namespace mpm
     settings.damping        = parameters.damping;
     settings.flip_fraction  = parameters.flip_fraction;
     settings.domain_update  = parameters.domain_update;
+    settings.pressure_averaging = parameters.pressure_averaging;
     settings.mass_tolerance = 0;
     {
       // Nodes lighter than 1e-12 of the smallest point carry no velocity.

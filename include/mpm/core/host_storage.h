@@ -77,6 +77,7 @@ namespace mpm
     std::vector<int>          lattice_to_node;
     std::vector<Real>         mass, momentum[dim], force[dim], velocity[dim];
     std::vector<std::uint8_t> fixed_components;
+    std::vector<Real>         cell_volume, cell_pressure_volume; // pressure-averaging scratch, one per lattice cell
 
     // A dense grid whose node numbering is the lattice numbering (standalone use).
     void make_dense(const Real lower[dim], const Real cell_size, const int cells[dim])
@@ -93,6 +94,17 @@ namespace mpm
       for (long i = 0; i < n; ++i)
         lattice_to_node[i] = static_cast<int>(i);
       allocate_nodes(static_cast<int>(n));
+      allocate_cells();
+    }
+
+    // Scratch of the cell pressure averaging, one entry per lattice cell.
+    void allocate_cells()
+    {
+      long n = 1;
+      for (int d = 0; d < dim; ++d)
+        n *= n_cells[d];
+      cell_volume.assign(n, Real(0));
+      cell_pressure_volume.assign(n, Real(0));
     }
 
     void allocate_nodes(const int n_nodes)
@@ -133,6 +145,11 @@ namespace mpm
       v.n_nodes          = static_cast<int>(mass.size());
       v.mass             = mass.data();
       v.fixed_components = fixed_components.data();
+      if (!cell_volume.empty())
+        {
+          v.cell_volume          = cell_volume.data();
+          v.cell_pressure_volume = cell_pressure_volume.data();
+        }
       return v;
     }
   };

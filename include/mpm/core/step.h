@@ -13,6 +13,7 @@
 #include <mpm/core/views.h>
 
 #include <cmath>
+#include <stdexcept>
 
 namespace mpm
 {
@@ -40,6 +41,9 @@ namespace mpm
     Real         flip_fraction;  // 1: pure FLIP, 0: pure PIC
     DomainUpdate domain_update;  // uGIMP or cpGIMP variants
     Real         mass_tolerance; // nodes lighter than this carry no velocity
+    // Cell-wise volume-weighted pressure averaging after the constitutive update
+    // (remedy for volumetric locking); needs the grid's cell arrays.
+    bool pressure_averaging = false;
   };
 
   // Per-step reductions over the points: the next time step needs the largest speed,
@@ -319,6 +323,47 @@ namespace mpm
       });
     }
 
+    // Cell pressure averaging (against volumetric locking, as in ep2-3De): every point
+    // of a lattice cell gets the volume-weighted mean pressure of the cell,
+    //   p_c = sum_p V_p p_p / sum_p V_p,   sigma_p <- s_p - p_c I   (s_p deviatoric part kept),
+    // with p = -tr(sigma)/3 (plane strain: sigma_zz included). Two passes through the
+    // backend: scatter V_p and V_p p_p into per-cell sums, then gather p_c back.
+    // The averaged stress is not returned to the yield surface again (ep2-3De neither).
+    template <int dim, typename Real, typename Backend>
+    void average_cell_pressure(Backend &backend, const GridView<dim, Real> &g, const PointsView<dim, Real> &p)
+    {
+      if (g.cell_volume == nullptr || g.cell_pressure_volume == nullptr)
+        throw std::invalid_argument("pressure averaging needs GridView::cell_volume and cell_pressure_volume");
+      backend.for_each_node(g.n_lattice_cells(), [=] MPM_HOST_DEVICE(const int c) {
+        g.cell_volume[c]          = Real(0);
+        g.cell_pressure_volume[c] = Real(0);
+      });
+      backend.scatter_points(p.n_points, [=] MPM_HOST_DEVICE(const int i) {
+        if (p.material[i] < 0)
+          return;
+        Real x[dim];
+        for (int d = 0; d < dim; ++d)
+          x[d] = p.position[d][i];
+        const int  c    = g.lattice_cell(x);
+        const Real V    = p.volume[i];
+        const Real mean = (p.stress[0][i] + p.stress[1][i] + p.stress[2][i]) / Real(3);
+        Backend::add(&g.cell_volume[c], V);
+        Backend::add(&g.cell_pressure_volume[c], V * mean);
+      });
+      backend.gather_points(p.n_points, [=] MPM_HOST_DEVICE(const int i) {
+        if (p.material[i] < 0)
+          return;
+        Real x[dim];
+        for (int d = 0; d < dim; ++d)
+          x[d] = p.position[d][i];
+        const int  c      = g.lattice_cell(x);
+        const Real mean   = (p.stress[0][i] + p.stress[1][i] + p.stress[2][i]) / Real(3);
+        const Real shift  = g.cell_pressure_volume[c] / g.cell_volume[c] - mean;
+        for (int k = 0; k < 3; ++k)
+          p.stress[k][i] += shift;
+      });
+    }
+
     template <int dim, typename Real, typename Backend>
     StepReduction<Real> reduce_step(Backend &backend, const PointsView<dim, Real> &p,
                                     const StepSettings<dim, Real> &s)
@@ -378,6 +423,8 @@ namespace mpm
           exchange.sum_nodal(momentum, dim);
           velocity_from_momentum(backend, g, s.mass_tolerance);
           grid_to_particle_kinematics<dim, Shape>(backend, g, p, materials, s, dt, true, true);
+          if (s.pressure_averaging)
+            average_cell_pressure(backend, g, p);
           break;
 
         case UpdateScheme::usl:
@@ -388,6 +435,8 @@ namespace mpm
           update_grid(backend, g, s, dt);
           grid_to_particle_velocity<dim, Shape>(backend, g, p, s, dt);
           grid_to_particle_kinematics<dim, Shape>(backend, g, p, materials, s, dt, true, true);
+          if (s.pressure_averaging)
+            average_cell_pressure(backend, g, p);
           break;
 
         case UpdateScheme::usf:
@@ -396,6 +445,8 @@ namespace mpm
           exchange.sum_nodal(mass_and_momentum, dim + 1);
           velocity_from_momentum(backend, g, s.mass_tolerance);
           grid_to_particle_kinematics<dim, Shape>(backend, g, p, materials, s, dt, false, true);
+          if (s.pressure_averaging)
+            average_cell_pressure(backend, g, p);
           particles_to_grid<dim, Shape>(backend, g, p, s, false, true);
           exchange.sum_nodal(forces, dim);
           update_grid(backend, g, s, dt);

@@ -6,6 +6,7 @@
 
 #include <mpm/core/config.h>
 
+#include <cmath>
 #include <cstdint>
 
 namespace mpm
@@ -26,6 +27,33 @@ namespace mpm
     Real *force[dim];    // force, after the grid update: acceleration
     Real *velocity[dim]; // nodal velocity used by G2P kinematics
     const std::uint8_t *fixed_components; // bit d set: velocity component d is prescribed zero
+
+    // Per-cell scratch sums of the optional cell pressure averaging (step.h), one entry
+    // per lattice cell, indexed like lattice_cell(). Null where the owner of the grid
+    // arrays provides none; the step then refuses pressure averaging.
+    Real *cell_volume          = nullptr; // sum of V_p over the points of the cell
+    Real *cell_pressure_volume = nullptr; // sum of V_p p_p
+
+    MPM_HOST_DEVICE int n_lattice_cells() const
+    {
+      int n = 1;
+      for (int d = 0; d < dim; ++d)
+        n *= n_cells[d];
+      return n;
+    }
+
+    // Lattice cell containing x (clamped to the grid): i + n_x (j + n_y k).
+    MPM_HOST_DEVICE int lattice_cell(const Real x[dim]) const
+    {
+      int cell = 0;
+      for (int d = dim - 1; d >= 0; --d)
+        {
+          int i = static_cast<int>(std::floor((x[d] - origin[d]) / h));
+          i     = i < 0 ? 0 : (i >= n_cells[d] ? n_cells[d] - 1 : i);
+          cell  = cell * n_cells[d] + i;
+        }
+      return cell;
+    }
 
     MPM_HOST_DEVICE int n_lattice_nodes(const int d) const { return n_cells[d] + 1; }
 

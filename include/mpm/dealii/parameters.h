@@ -57,6 +57,7 @@ namespace mpm
     std::vector<double> gravity;
     double       gravity_ramp_time;
     double       plasticity_start_time;
+    bool         pressure_averaging; // cell-wise volume-weighted pressure averaging
     unsigned int max_steps;
 
     // Materials, in the order of their names; bodies refer to them by index.
