@@ -3,7 +3,7 @@
 # Used by scripts/demo.sh and scripts/test.sh; safe to run again.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-packages="libdeal.ii-dev cmake g++ make openmpi-bin libopenmpi-dev python3-numpy python3-matplotlib python3-meshio"
+packages="libdeal.ii-dev libfftw3-dev cmake g++ make openmpi-bin libopenmpi-dev python3-numpy python3-matplotlib python3-meshio"
 missing=""
 for p in $packages; do dpkg -s "$p" >/dev/null 2>&1 || missing="$missing $p"; done
 if [ -n "$missing" ]; then
