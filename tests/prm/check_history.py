@@ -3,6 +3,9 @@
   --finite                    every value is finite
   --conserved COL[,COL...]    the columns stay equal to their first value (relative --rtol)
   --removed-at-least N        at least N points were removed (left the grid) by the end
+  --energy-bounded            the kinetic energy never exceeds the work done by gravity (+1%; the
+                              initial elastic energy of the scenes that use it is negligible)
+  --at-rest F                 the final kinetic energy is below F times the work done by gravity
   (with --removed-at-least, also: the mass left is that of the points left)"""
 import argparse
 import os
@@ -20,6 +23,8 @@ parser.add_argument("--conserved", default="")
 parser.add_argument("--rtol", default="1e-12",
                     help="relative tolerance, or 'auto': n_points * 2.2e-16, the round-off bound of a sum over the points in any order")
 parser.add_argument("--removed-at-least", type=int, default=0)
+parser.add_argument("--energy-bounded", action="store_true")
+parser.add_argument("--at-rest", type=float)
 args = parser.parse_args()
 
 h = mpm_results.history(args.output_dir)
@@ -53,5 +58,17 @@ if args.removed_at_least:
     point_mass = h["total_mass"][0] / h["n_points"][0]
     if abs(h["total_mass"][-1] - point_mass * h["n_points"][-1]) > 1e-12 * h["total_mass"][0]:
         print("FAILED: the mass left does not match the points left")
+        failed = True
+if args.energy_bounded:
+    excess = np.max(h["kinetic_energy"] - 1.01 * np.maximum(h["work_of_gravity"], 0))
+    print(f"max (kinetic energy - 1.01 work of gravity): {excess:.3e} J (must be <= 0)")
+    if not excess <= 1e-12 * max(np.max(np.abs(h["work_of_gravity"])), 1e-300):
+        print("FAILED: the kinetic energy exceeds the work done by gravity")
+        failed = True
+if args.at_rest is not None:
+    ratio = h["kinetic_energy"][-1] / max(h["work_of_gravity"][-1], 1e-300)
+    print(f"final kinetic energy / work of gravity: {ratio:.3e} (tolerance {args.at_rest:.1e})")
+    if not ratio <= args.at_rest:
+        print("FAILED: not at rest at the end")
         failed = True
 sys.exit(1 if failed else 0)

@@ -14,6 +14,7 @@
 
 #include <cmath>
 #include <stdexcept>
+#include <type_traits>
 
 namespace mpm
 {
@@ -64,8 +65,45 @@ namespace mpm
     {}
   };
 
+  // Backends whose scatters run in parallel by colouring (CpuBackend) declare
+  // `static constexpr bool colours_scatter = true` and group the points first.
+  template <typename Backend, typename = void>
+  struct colours_scatter : std::false_type
+  {};
+  template <typename Backend>
+  struct colours_scatter<Backend, std::void_t<decltype(Backend::colours_scatter)>>
+    : std::bool_constant<Backend::colours_scatter>
+  {};
+
   namespace stages
   {
+    // For colouring backends: group the points by the first lattice layer of their
+    // stencil along the longest grid axis, before the scatters of a point
+    // configuration (again whenever the points have moved). A point's scatters write
+    // nodes of layers [first, first + n_per_direction - 1] and its own cell, which lies
+    // in that range too. Other backends (CUDA: atomics) need nothing.
+    template <int dim, typename Shape, typename Real, typename Backend>
+    void group_for_scatter(Backend &backend, const GridView<dim, Real> &g, const PointsView<dim, Real> &p)
+    {
+      if constexpr (colours_scatter<Backend>::value)
+        {
+          int axis = 0;
+          for (int d = 1; d < dim; ++d)
+            if (g.n_cells[d] > g.n_cells[axis])
+              axis = d;
+          constexpr int n = Shape::n_per_direction;
+          backend.group_points(p.n_points, g.n_cells[axis] + 1, n, [&](const int i) {
+            if (p.material[i] < 0)
+              return -1;
+            int  first;
+            Real w[n], dw[n];
+            Shape::weights_1d((p.position[axis][i] - g.origin[axis]) / g.h, p.domain_half_length[axis][i] / g.h,
+                              first, w, dw);
+            return first < 0 ? 0 : first;
+          });
+        }
+    }
+
     template <int dim, typename Real, typename Backend>
     void reset_grid(Backend &backend, const GridView<dim, Real> &g, const bool mass_too)
     {
@@ -410,6 +448,7 @@ namespace mpm
         forces[d]                              = g.force[d];
       }
 
+    group_for_scatter<dim, Shape>(backend, g, p);
     switch (s.scheme)
       {
         case UpdateScheme::musl:
@@ -424,7 +463,10 @@ namespace mpm
           velocity_from_momentum(backend, g, s.mass_tolerance);
           grid_to_particle_kinematics<dim, Shape>(backend, g, p, materials, s, dt, true, true);
           if (s.pressure_averaging)
-            average_cell_pressure(backend, g, p);
+            {
+              group_for_scatter<dim, Shape>(backend, g, p); // the points have moved
+              average_cell_pressure(backend, g, p);
+            }
           break;
 
         case UpdateScheme::usl:
@@ -436,7 +478,10 @@ namespace mpm
           grid_to_particle_velocity<dim, Shape>(backend, g, p, s, dt);
           grid_to_particle_kinematics<dim, Shape>(backend, g, p, materials, s, dt, true, true);
           if (s.pressure_averaging)
-            average_cell_pressure(backend, g, p);
+            {
+              group_for_scatter<dim, Shape>(backend, g, p); // the points have moved
+              average_cell_pressure(backend, g, p);
+            }
           break;
 
         case UpdateScheme::usf:
@@ -454,6 +499,8 @@ namespace mpm
           grid_to_particle_kinematics<dim, Shape>(backend, g, p, materials, s, dt, true, false);
           break;
       }
+    if constexpr (colours_scatter<Backend>::value)
+      backend.ungroup(); // the points have moved: a later scatter must not trust the grouping
     return reduce_step(backend, p, s);
   }
 

@@ -1,10 +1,26 @@
 // CPU backend: how the step's loops run on the host.
 // Node loops and gather loops (each point writes only itself) run in parallel
-// through TBB when available. Scatter loops run serially, so plain additions are
-// race-free and the sums are deterministic (same order every run).
+// through TBB when available. Scatter loops run in parallel by colouring:
+//
+//   The step first groups the points (group_points, once per point configuration)
+//   by the lattice index k along one axis at which their scatter stencil starts;
+//   a point's scatter then writes only entries whose lattice index along that axis
+//   lies in [k, k + span - 1]. Points are binned into slabs of `span` lattice
+//   layers; slab b writes only layers [b span, b span + 2 span - 2], so slabs b and
+//   b + 2 never touch the same entry. All even slabs run in parallel, then all odd
+//   slabs: plain additions, no atomics, no races.
+//
+// Within a slab the points run in index order and the slabs of one colour write
+// disjoint entries, so every sum is formed in the same order on every run and for
+// any number of threads: results are deterministic (though not bit-identical with
+// the serial order). Removed points (key < 0) are left out of the grouping, so
+// scatters do no work for them. Without a grouping (or without TBB) a scatter runs
+// serially over all points.
 #pragma once
 
 #include <mpm/core/config.h>
+
+#include <vector>
 
 #ifdef MPM_WITH_TBB
 #  include <tbb/blocked_range.h>
@@ -17,6 +33,9 @@ namespace mpm
   struct CpuBackend
   {
     static constexpr const char *name = "cpu";
+
+    // The step calls group_points before scatters (see step.h, group_for_scatter).
+    static constexpr bool colours_scatter = true;
 
     // MPM_HOST_DEVICE only so that nvcc accepts the step's __host__ __device__ lambdas
     // instantiated with this backend in a .cu file; it only ever runs on the host.
@@ -38,9 +57,58 @@ namespace mpm
       parallel(n, f);
     }
 
+    // Groups points 0..n-1 for the coming scatters: key(i) is the first lattice index
+    // (along the colouring axis, 0 <= key < n_layers) that point i's scatter writes,
+    // and the point writes at most `span` consecutive layers from there; key(i) < 0
+    // leaves the point out (removed). Valid until the points move: the step regroups.
+    template <typename Key>
+    void group_points(const int n, const int n_layers, const int span, Key &&key)
+    {
+      const int n_slabs = (n_layers + span - 1) / span;
+      slab_of.resize(n);
+      slab_start.assign(n_slabs + 1, 0);
+      for (int i = 0; i < n; ++i)
+        {
+          const int k = key(i);
+          slab_of[i]  = k < 0 ? -1 : (k >= n_layers ? n_layers - 1 : k) / span;
+          if (slab_of[i] >= 0)
+            ++slab_start[slab_of[i] + 1];
+        }
+      for (int b = 0; b < n_slabs; ++b)
+        slab_start[b + 1] += slab_start[b];
+      order.resize(slab_start[n_slabs]);
+      fill.assign(slab_start.begin(), slab_start.end() - 1);
+      for (int i = 0; i < n; ++i)
+        if (slab_of[i] >= 0)
+          order[fill[slab_of[i]]++] = i;
+      grouped_points = n;
+    }
+
+    // Forgets the grouping (scatters then run serially over all points).
+    void ungroup() { grouped_points = -1; }
+
     template <typename F>
     void scatter_points(const int n, F &&f) const
     {
+#ifdef MPM_WITH_TBB
+      if (grouped_points == n && n > grain)
+        {
+          const int n_slabs = static_cast<int>(slab_start.size()) - 1;
+          for (int colour = 0; colour < 2; ++colour)
+            {
+              const int n_coloured = (n_slabs - colour + 1) / 2; // slabs colour, colour + 2, ...
+              tbb::parallel_for(tbb::blocked_range<int>(0, n_coloured, 1), [&](const tbb::blocked_range<int> &r) {
+                for (int s = r.begin(); s < r.end(); ++s)
+                  {
+                    const int b = colour + 2 * s;
+                    for (int j = slab_start[b]; j < slab_start[b + 1]; ++j)
+                      f(order[j]);
+                  }
+              });
+            }
+          return;
+        }
+#endif
       for (int i = 0; i < n; ++i)
         f(i);
     }
@@ -69,6 +137,11 @@ namespace mpm
 
   private:
     static constexpr int grain = 2048;
+
+    // Grouping for the coloured scatter: points of slab b are order[slab_start[b] ..
+    // slab_start[b + 1]), in index order.
+    int              grouped_points = -1;
+    std::vector<int> slab_of, slab_start, fill, order;
 
     template <typename F>
     static void parallel(const int n, F &f)
