@@ -1,5 +1,6 @@
 #include <mpm/dealii/background_grid.h>
 
+#include <deal.II/base/partitioner.templates.h>
 #include <deal.II/base/utilities.h>
 #include <deal.II/dofs/dof_tools.h>
 #include <deal.II/grid/grid_generator.h>
@@ -11,26 +12,49 @@ namespace mpm
   template <int dim>
   BackgroundGrid<dim>::BackgroundGrid(const Parameters &parameters, MPI_Comm communicator)
     : communicator(communicator)
+    , n_ranks(dealii::Utilities::MPI::n_mpi_processes(communicator))
     , triangulation(communicator)
     , fe(1)
     , dof_handler(triangulation)
+    , boundary(parameters.boundary)
   {
     h = parameters.cell_size;
     std::vector<unsigned int> repetitions(dim);
     dealii::Point<dim>        p1, p2;
-    long                      n_lattice_cells = 1, n_lattice_nodes = 1;
+    // p4est orders the coarse cells as given (lexicographically: a partition into
+    // slabs) and the cells inside each coarse cell along a Morton curve (compact
+    // blocks, fewer ghost nodes per owned node). Coarse cells of 2^levels x 2^levels
+    // lattice cells, refined globally, give the same lattice with compact partitions.
+    unsigned int levels = 10;
     for (unsigned int d = 0; d < dim; ++d)
       {
-        origin[d]      = parameters.lower[d];
-        n_cells[d]     = static_cast<int>(std::lround((parameters.upper[d] - parameters.lower[d]) / h));
-        repetitions[d] = n_cells[d];
-        p1[d]          = parameters.lower[d];
-        p2[d]          = parameters.lower[d] + n_cells[d] * h;
+        origin[d]  = parameters.lower[d];
+        n_cells[d] = static_cast<int>(std::lround((parameters.upper[d] - parameters.lower[d]) / h));
+        unsigned int twos = 0;
+        while (twos < levels && (n_cells[d] >> twos) % 2 == 0)
+          ++twos;
+        levels = std::min(levels, twos);
+        p1[d]  = parameters.lower[d];
+        p2[d]  = parameters.lower[d] + n_cells[d] * h;
+      }
+    for (unsigned int d = 0; d < dim; ++d)
+      repetitions[d] = n_cells[d] >> levels;
+    // colorize: boundary ids 0..2dim-1 for x min, x max, y min, ...; children inherit them.
+    dealii::GridGenerator::subdivided_hyper_rectangle(triangulation, repetitions, p1, p2, true);
+    triangulation.refine_global(levels);
+    distribute_nodes();
+  }
+
+  template <int dim>
+  void BackgroundGrid<dim>::distribute_nodes()
+  {
+    long n_lattice_cells = 1, n_lattice_nodes = 1;
+    for (unsigned int d = 0; d < dim; ++d)
+      {
         n_lattice_cells *= n_cells[d];
         n_lattice_nodes *= n_cells[d] + 1;
       }
-    // colorize: boundary ids 0..2dim-1 for x min, x max, y min, ...
-    dealii::GridGenerator::subdivided_hyper_rectangle(triangulation, repetitions, p1, p2, true);
+
     dof_handler.distribute_dofs(fe);
     locally_owned_dofs = dof_handler.locally_owned_dofs();
     dealii::DoFTools::extract_locally_relevant_dofs(dof_handler, locally_relevant_dofs);
@@ -42,12 +66,6 @@ namespace mpm
         momentum[d].reinit(partitioner);
         force[d].reinit(partitioner);
         velocity[d].reinit(partitioner);
-      }
-    vector_of_array[mass.begin()] = &mass;
-    for (unsigned int d = 0; d < dim; ++d)
-      {
-        vector_of_array[momentum[d].begin()] = &momentum[d];
-        vector_of_array[force[d].begin()]    = &force[d];
       }
 
     const unsigned int n_local_nodes = partitioner->locally_owned_size() + partitioner->n_ghost_indices();
@@ -66,6 +84,7 @@ namespace mpm
       return index;
     };
 
+    // Owned and ghost cells: their vertices are exactly the locally relevant nodes.
     for (const auto &cell : dof_handler.active_cell_iterators())
       {
         if (cell->is_artificial())
@@ -79,11 +98,13 @@ namespace mpm
               static_cast<int>(partitioner->global_to_local(global));
           }
         // Boundary masks from the face ids: no-slip fixes every component, free-slip the normal one.
+        // Every cell touching a boundary node has a face with that node on that boundary, so ghost
+        // nodes get the same mask as on their owner.
         for (const unsigned int f : cell->face_indices())
           if (cell->face(f)->at_boundary())
             {
               const unsigned int id   = cell->face(f)->boundary_id();
-              const BoundaryType type = parameters.boundary[id];
+              const BoundaryType type = boundary[id];
               if (type == BoundaryType::free)
                 continue;
               const std::uint8_t bits = type == BoundaryType::no_slip ? std::uint8_t((1u << dim) - 1) :
@@ -119,7 +140,7 @@ namespace mpm
   template <int dim>
   mpm::GridView<dim, double> BackgroundGrid<dim>::view()
   {
-    mpm::GridView<dim, double> v;
+    mpm::GridView<dim, double> v{};
     for (unsigned int d = 0; d < dim; ++d)
       {
         v.origin[d]   = origin[d];
@@ -137,18 +158,70 @@ namespace mpm
   }
 
   template <int dim>
-  void BackgroundGrid<dim>::sum_nodal(double *const *arrays, const int count) const
+  std::size_t BackgroundGrid<dim>::exchange_bytes_per_array() const
   {
-    if (dealii::Utilities::MPI::n_mpi_processes(communicator) == 1)
+    // Import sends each ghost entry to its owner, export sends it back.
+    return 2 * sizeof(double) * partitioner->n_ghost_indices();
+  }
+
+  namespace
+  {
+    template <typename Real>
+    std::vector<Real> &buffer_of(std::vector<double> &d, std::vector<float> &f);
+    template <>
+    std::vector<double> &buffer_of<double>(std::vector<double> &d, std::vector<float> &)
+    {
+      return d;
+    }
+    template <>
+    std::vector<float> &buffer_of<float>(std::vector<double> &, std::vector<float> &f)
+    {
+      return f;
+    }
+  } // namespace
+
+  // The Partitioner's raw-array exchange, as LinearAlgebra::distributed::Vector's
+  // compress(add) + update_ghost_values() do internally, but without the vector's
+  // ghosted/non-ghosted state (writing into ghost entries of a vector in the ghosted
+  // state and then compressing is what deal.II forbids). All arrays of one call are in
+  // flight together, each on its own channel:
+  //   import: ghost entries are added into their owners' entries, then zeroed;
+  //   export: owners' sums are copied into every rank's ghost entries.
+  template <int dim>
+  template <typename Real>
+  void BackgroundGrid<dim>::sum_nodal(Real *const *arrays, const int count) const
+  {
+    if (n_ranks == 1)
       return;
+    const unsigned int n_owned  = partitioner->locally_owned_size();
+    const unsigned int n_ghost  = partitioner->n_ghost_indices();
+    const unsigned int n_import = partitioner->n_import_indices();
+    std::vector<Real> &buffer   = buffer_of<Real>(buffer_double, buffer_float);
+    buffer.resize(std::size_t(count) * n_import);
+    requests.resize(std::max<std::size_t>(requests.size(), count));
+
+    using dealii::ArrayView;
+    auto owned = [&](const int i) { return ArrayView<Real>(arrays[i], n_owned); };
+    auto ghost = [&](const int i) { return ArrayView<Real>(arrays[i] + n_owned, n_ghost); };
+    auto temp  = [&](const int i) { return ArrayView<Real>(buffer.data() + std::size_t(i) * n_import, n_import); };
+
     for (int i = 0; i < count; ++i)
-      {
-        Vector *v = vector_of_array.at(arrays[i]);
-        v->compress(dealii::VectorOperation::add);
-        v->update_ghost_values();
-      }
+      partitioner->import_from_ghosted_array_start(dealii::VectorOperation::add, i, ghost(i), temp(i), requests[i]);
+    for (int i = 0; i < count; ++i)
+      partitioner->import_from_ghosted_array_finish(dealii::VectorOperation::add,
+                                                    ArrayView<const Real>(temp(i).data(), n_import), owned(i),
+                                                    ghost(i), requests[i]);
+    for (int i = 0; i < count; ++i)
+      partitioner->export_to_ghosted_array_start(i, ArrayView<const Real>(arrays[i], n_owned), temp(i), ghost(i),
+                                                 requests[i]);
+    for (int i = 0; i < count; ++i)
+      partitioner->export_to_ghosted_array_finish(ghost(i), requests[i]);
   }
 
   template class BackgroundGrid<2>;
   template class BackgroundGrid<3>;
+  template void BackgroundGrid<2>::sum_nodal(double *const *, int) const;
+  template void BackgroundGrid<3>::sum_nodal(double *const *, int) const;
+  template void BackgroundGrid<2>::sum_nodal(float *const *, int) const;
+  template void BackgroundGrid<3>::sum_nodal(float *const *, int) const;
 } // namespace mpm

@@ -1,4 +1,5 @@
 #include <mpm/core/backend/cpu_backend.h>
+#include <mpm/core/migration.h>
 #include <mpm/dealii/engine.h>
 
 #include <deal.II/base/exceptions.h>
@@ -24,13 +25,35 @@ namespace mpm
         cell_pressure_volume.assign(n_cells, 0.);
       }
 
-      void load(const MaterialPoints<dim> &p) override { p.copy_to(points); }
+      void load(const MaterialPoints<dim> &p) override { p.copy_to(points, &home_cells); }
 
       unsigned int store(MaterialPoints<dim> &p) override
       {
         const unsigned int removed = p.copy_from(points);
-        p.copy_to(points); // the handler re-sorted them: take the new order
+        p.copy_to(points, &home_cells); // the handler re-sorted them: take the new order
         return removed;
+      }
+
+      double max_distance_outside_home_cells() override
+      {
+        const auto   view = points.view();
+        const long  *home = home_cells.data();
+        const double h    = grid.h;
+        double       origin[dim];
+        int          n_cells[dim];
+        for (int d = 0; d < dim; ++d)
+          {
+            origin[d]  = grid.origin[d];
+            n_cells[d] = grid.n_cells[d];
+          }
+        return backend.reduce_points(
+          view.n_points, 0.0,
+          [&](const int i) {
+            return view.material[i] < 0 ? 0.0 :
+                                          distance_outside_home_cell<dim>(origin, h, n_cells, view.position,
+                                                                          home[i], i);
+          },
+          [](const double a, const double b) { return a > b ? a : b; });
       }
 
       StepReduction<double> step(const StepSettings<dim, double> &s, const double dt) override
@@ -51,6 +74,7 @@ namespace mpm
       ShapeFunction                           shape;
       CpuBackend                              backend;
       HostPoints<dim, double>                 points;
+      std::vector<long>                       home_cells; // lattice cell of each point at the last sort
       std::vector<double>                     cell_volume, cell_pressure_volume; // pressure-averaging scratch
     };
   } // namespace

@@ -50,10 +50,25 @@ namespace mpm
   }
 
   template <int dim>
-  MaterialPoints<dim>::MaterialPoints(BackgroundGrid<dim> &grid, const Parameters &)
+  MaterialPoints<dim>::MaterialPoints(BackgroundGrid<dim> &grid, const Parameters &parameters)
     : handler(grid.triangulation, grid.mapping, PropertyLayout<dim>::n_properties)
     , grid(grid)
-  {}
+  {
+    // Work of a cell for p4est's weighted partition (deal.II's 'weight' signal, no base
+    // weight): an empty cell costs 1 unit (node updates), each point Point weight units.
+    // Integer weights: scaled by 16 so that fractional point weights keep their meaning.
+    const unsigned int cell_weight  = 16;
+    const unsigned int point_weight = static_cast<unsigned int>(std::lround(16 * parameters.point_weight));
+    this->point_weight              = point_weight / 16.;
+    using CellStatus = typename dealii::Triangulation<dim>::CellStatus;
+    weight_connection = grid.triangulation.signals.weight.connect(
+      [this, cell_weight, point_weight](const typename dealii::Triangulation<dim>::cell_iterator &cell,
+                                        const CellStatus status) -> unsigned int {
+        // The background grid is never refined or coarsened: only CELL_PERSIST occurs.
+        (void)status;
+        return cell_weight + point_weight * handler.n_particles_in_cell(cell);
+      });
+  }
 
   namespace
   {
@@ -168,14 +183,24 @@ namespace mpm
   }
 
   template <int dim>
-  void MaterialPoints<dim>::copy_to(HostPoints<dim, double> &p) const
+  void MaterialPoints<dim>::copy_to(HostPoints<dim, double> &p, std::vector<long> *home_cells) const
   {
     using Layout = PropertyLayout<dim>;
     p.resize(0);
     p.resize(handler.n_locally_owned_particles());
+    if (home_cells)
+      home_cells->resize(handler.n_locally_owned_particles());
     int i = 0;
     for (const auto &particle : handler)
       {
+        if (home_cells)
+          {
+            const auto center = particle.get_surrounding_cell()->center();
+            double     c[dim];
+            for (int d = 0; d < dim; ++d)
+              c[d] = center[d];
+            (*home_cells)[i] = grid.lattice_cell_of(c);
+          }
         const auto x    = particle.get_location();
         const auto prop = particle.get_properties();
         for (int d = 0; d < dim; ++d)
@@ -232,10 +257,37 @@ namespace mpm
         prop[Layout::volume]         = p.volume[i];
         prop[Layout::plastic_strain] = p.plastic_strain[i];
         particle->set_location(x);
+        if (grid.n_ranks > 1 && grid.owned_cell(grid.lattice_cell_of(&x[0])) == grid.triangulation.end())
+          ++n_sent; // now in another rank's cell (a point on a shared face may stay)
       }
     handler.remove_particles(removed);
+    // deal.II finds the new cell among the neighbours of the old one, else in the
+    // owned and ghost cells; points in ghost cells go to their owners. The step loop
+    // keeps every point closer than one cell to its old cell, so none is lost.
     handler.sort_particles_into_subdomains_and_cells();
     return static_cast<unsigned int>(removed.size());
+  }
+
+  template <int dim>
+  double MaterialPoints<dim>::imbalance() const
+  {
+    // The work model of the partition's cell weights: cells plus weighted points.
+    const double local = grid.triangulation.n_locally_owned_active_cells() +
+                         point_weight * static_cast<double>(handler.n_locally_owned_particles());
+    const double most  = dealii::Utilities::MPI::max(local, grid.communicator);
+    const double total = dealii::Utilities::MPI::sum(local, grid.communicator);
+    return total > 0 ? most * grid.n_ranks / total : 1.0;
+  }
+
+  template <int dim>
+  void MaterialPoints<dim>::repartition()
+  {
+    // As deal.II's step-68: the handler packs its points with their cells, p4est moves
+    // cells by weight, the handler unpacks them on the new owners.
+    handler.prepare_for_coarsening_and_refinement();
+    grid.triangulation.repartition();
+    handler.unpack_after_coarsening_and_refinement();
+    grid.distribute_nodes();
   }
 
   template struct PropertyLayout<2>;

@@ -7,6 +7,7 @@
 
 #include <filesystem>
 #include <iomanip>
+#include <sstream>
 
 namespace mpm
 {
@@ -16,18 +17,30 @@ namespace mpm
     , output_directory(parameters.output_directory)
     , write_grid(parameters.write_grid_fields)
     , write_particles(parameters.write_particles)
+    , write_table(parameters.write_particle_table)
   {
     if (output_directory.empty())
       output_directory = ".";
+    // Rank 0 creates the folder and the history; every rank learns whether that worked,
+    // so that a bad Output/Directory stops all ranks with one message instead of a hang.
+    std::string problem;
     if (dealii::Utilities::MPI::this_mpi_process(communicator) == 0)
       {
         std::error_code error;
         std::filesystem::create_directories(output_directory, error);
-        AssertThrow(!error, dealii::ExcMessage("Parameter 'Output/Directory': cannot create '" + output_directory +
-                                               "': " + error.message()));
-        history.open(output_directory + "/history.csv");
-        AssertThrow(history, dealii::ExcMessage("Parameter 'Output/Directory': cannot write to '" +
-                                                output_directory + "'."));
+        if (error)
+          problem = "cannot create '" + output_directory + "': " + error.message();
+        else
+          {
+            history.open(output_directory + "/history.csv");
+            if (!history)
+              problem = "cannot write to '" + output_directory + "'.";
+          }
+      }
+    problem = dealii::Utilities::MPI::broadcast(communicator, problem, 0);
+    AssertThrow(problem.empty(), dealii::ExcMessage("Parameter 'Output/Directory': " + problem));
+    if (dealii::Utilities::MPI::this_mpi_process(communicator) == 0)
+      {
         history << "time,dt,step,kinetic_energy,work_of_gravity,total_mass";
         for (int d = 0; d < dim; ++d)
           history << ",momentum_" << "xyz"[d];
@@ -36,9 +49,9 @@ namespace mpm
           history << ",min_" << "xyz"[d];
         for (int d = 0; d < dim; ++d)
           history << ",max_" << "xyz"[d];
+        history << ",min_points_per_rank,max_points_per_rank,n_resorts,n_repartitions,n_sent";
         history << "\n" << std::setprecision(16);
       }
-    MPI_Barrier(communicator); // the folder exists before any rank writes into it
   }
 
   template <int dim>
@@ -82,6 +95,43 @@ namespace mpm
             dealii::DataOutBase::write_pvd_record(pvd, particle_records);
           }
       }
+    if (write_table)
+      {
+        const unsigned int rank = dealii::Utilities::MPI::this_mpi_process(communicator);
+        std::ostringstream name;
+        name << output_directory << "/particle_table_" << std::setw(5) << std::setfill('0') << counter << '.'
+             << rank << ".csv";
+        std::ofstream table(name.str());
+        AssertThrow(table, dealii::ExcMessage("Parameter 'Output/Directory': cannot write '" + name.str() + "'."));
+        const auto names = PropertyLayout<dim>::names();
+        table << "id";
+        for (int d = 0; d < dim; ++d)
+          table << ",position_" << "xyz"[d];
+        std::vector<unsigned int> seen(names.size(), 0);
+        for (unsigned int k = 0; k < names.size(); ++k)
+          {
+            // Vector properties repeat their name: number their components.
+            unsigned int repeats = 0;
+            for (unsigned int j = 0; j < names.size(); ++j)
+              repeats += names[j] == names[k];
+            table << ',' << names[k];
+            if (repeats > 1)
+              table << '_' << "xyz"[seen[k]];
+            for (unsigned int j = k + 1; j < names.size(); ++j)
+              if (names[j] == names[k])
+                seen[j] = seen[k] + 1;
+          }
+        table << '\n' << std::setprecision(17);
+        for (const auto &particle : points.handler)
+          {
+            table << particle.get_id();
+            for (int d = 0; d < dim; ++d)
+              table << ',' << particle.get_location()[d];
+            for (const double value : particle.get_properties())
+              table << ',' << value;
+            table << '\n';
+          }
+      }
     ++counter;
   }
 
@@ -99,6 +149,8 @@ namespace mpm
       history << ',' << r.totals.lower[d];
     for (int d = 0; d < dim; ++d)
       history << ',' << r.totals.upper[d];
+    history << ',' << r.min_points_per_rank << ',' << r.max_points_per_rank << ',' << r.n_resorts << ','
+            << r.n_repartitions << ',' << r.n_sent;
     history << '\n';
     history.flush();
   }

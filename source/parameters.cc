@@ -192,6 +192,24 @@ namespace mpm
                       "Steps between rows of the time history (history.csv).");
     prm.declare_entry("Progress interval", "2", Patterns::Double(0),
                       "Wall-clock seconds between progress lines on the screen; 0 = none.");
+    prm.declare_entry("Write particle table", "false", Patterns::Bool(),
+                      "Also write particle_table_NNNNN.R.csv (one per output and rank R): id, position and every "
+                      "property in full precision, for comparisons the single-precision .vtu files cannot resolve.");
+    prm.leave_subsection();
+
+    prm.enter_subsection("Parallel");
+    prm.declare_entry("Re-sort distance", "1", Patterns::Double(0, 1),
+                      "MPI runs: the points are re-sorted into cells and ranks (migrating to the rank owning their "
+                      "new cell) as soon as one point is this fraction of the safe distance outside the cell it was "
+                      "sorted into (the safe distance, half a cell for GIMP and one cell for linear shape functions, "
+                      "keeps its stencil within the rank's nodes). 1 = only when needed, 0 = every step.");
+    prm.declare_entry("Load balance threshold", "1.1", Patterns::Double(0),
+                      "MPI runs: the grid is repartitioned by work (cells weighted by their points) when the largest "
+                      "work of one rank exceeds this multiple of the mean; checked at the start and after each "
+                      "re-sort. 0 = never repartition; otherwise at least 1.");
+    prm.declare_entry("Point weight", "20", Patterns::Double(0),
+                      "MPI runs: work of one material point relative to one empty grid cell, for the weighted "
+                      "partition (a cell weighs 1 + Point weight x its points).");
     prm.leave_subsection();
 
     prm.enter_subsection("Backend");
@@ -363,6 +381,16 @@ namespace mpm
     write_particles   = prm.get_bool("Write particles");
     history_every     = prm.get_integer("History every n steps");
     progress_interval = prm.get_double("Progress interval");
+    write_particle_table = prm.get_bool("Write particle table");
+    prm.leave_subsection();
+
+    prm.enter_subsection("Parallel");
+    resort_distance        = prm.get_double("Re-sort distance");
+    load_balance_threshold = prm.get_double("Load balance threshold");
+    point_weight           = prm.get_double("Point weight");
+    if (load_balance_threshold > 0 && load_balance_threshold < 1)
+      fail("Parallel/Load balance threshold", "must be 0 (never repartition) or at least 1, got " +
+                                                 prm.get("Load balance threshold") + ".");
     prm.leave_subsection();
 
     prm.enter_subsection("Backend");

@@ -1,3 +1,4 @@
+#include <mpm/core/migration.h>
 #include <mpm/dealii/background_grid.h>
 #include <mpm/dealii/engine.h>
 #include <mpm/dealii/material_points.h>
@@ -55,11 +56,11 @@ namespace mpm
   template <int dim>
   void Simulator<dim>::run()
   {
-    // Points do not yet migrate between ranks during the step loop (the MPI issue):
-    // refuse rather than compute wrong results.
-    AssertThrow(dealii::Utilities::MPI::n_mpi_processes(communicator) == 1,
-                dealii::ExcMessage("Runs on more than one MPI rank are not supported yet: run with one rank."));
-
+    // Pressure averaging sums over the points of a cell; between re-sorts a cell's points
+    // can sit on two ranks, and cell sums are not exchanged between ranks yet.
+    AssertThrow(!(parameters.pressure_averaging && dealii::Utilities::MPI::n_mpi_processes(communicator) > 1),
+                dealii::ExcMessage("Parameter 'Solver/Pressure averaging': not supported on more than one MPI rank "
+                                   "yet (cell sums are not exchanged); run on one rank or set it to false."));
     const double c_el = elastic_wave_speed(parameters);
     const double h    = parameters.cell_size;
     if (!parameters.adaptive_time_step)
@@ -87,6 +88,31 @@ namespace mpm
     bool plastic = !(parameters.plasticity_start_time > 0);
     for (auto &m : materials)
       m.plasticity_enabled = plastic;
+    // MPI: points re-sorted into cells and ranks, grid repartitioned by work.
+    const bool   parallel  = dealii::Utilities::MPI::n_mpi_processes(communicator) > 1;
+    const double resort_at = parameters.resort_distance * safe_distance_outside_home_cell(parameters.shape_function);
+    long         n_resorts = 0, n_repartitions = 0;
+    double       balanced  = 1; // imbalance right after the last repartition: what p4est achieves
+    // Repartition when the work per rank is out of balance by more than the threshold and
+    // by clearly more than the last repartition could reach (no futile repeats when the
+    // granularity of cells forbids better). Points per rank only change at re-sorts, so
+    // this is checked at the start and after each re-sort.
+    auto balance = [&]() {
+      if (!parallel || !(parameters.load_balance_threshold > 0))
+        return false;
+      const double before = points.imbalance();
+      if (before <= parameters.load_balance_threshold ||
+          before <= balanced + 0.5 * (parameters.load_balance_threshold - 1))
+        return false;
+      dealii::TimerOutput::Scope scope(timer, "repartition");
+      points.repartition();
+      ++n_repartitions;
+      balanced = points.imbalance();
+      pcout << "  repartitioned the grid by work: max/mean work per rank " << before << " -> " << balanced
+            << std::endl;
+      return true;
+    };
+    balance();
     auto engine = make_engine<dim>(parameters.backend, grid, materials, parameters.shape_function);
     engine->load(points);
     OutputWriter<dim> output(parameters, communicator);
@@ -121,9 +147,16 @@ namespace mpm
 
     auto record_history = [&]() {
       dealii::TimerOutput::Scope scope(timer, "history");
-      const auto totals = global_totals<dim>(engine->totals(), communicator);
+      const auto local  = engine->totals();
+      const auto totals = global_totals<dim>(local, communicator);
       n_removed         = n_points_initial - totals.n_points;
-      output.write_history({time, dt, work_of_gravity, step, n_removed, totals});
+      typename OutputWriter<dim>::HistoryRow row{time, dt, work_of_gravity, step, n_removed, totals};
+      row.min_points_per_rank = static_cast<long>(min(double(local.n_points), communicator));
+      row.max_points_per_rank = static_cast<long>(max(double(local.n_points), communicator));
+      row.n_resorts           = n_resorts;
+      row.n_repartitions      = n_repartitions;
+      row.n_sent              = static_cast<long>(sum(double(points.n_sent), communicator));
+      output.write_history(row);
     };
     auto write_output = [&]() {
       dealii::TimerOutput::Scope scope(timer, "output");
@@ -160,7 +193,24 @@ namespace mpm
           dealii::TimerOutput::Scope scope(timer, "MPM step");
           r = engine->step(settings, dt);
         }
-        max_speed = max(r.max_speed, communicator);
+        // One reduction for the next time step and the migration test: the largest
+        // speed and the largest distance of a point outside its home cell.
+        {
+          double local[2] = {r.max_speed, parallel ? engine->max_distance_outside_home_cells() : 0.0}, global[2];
+          dealii::Utilities::MPI::max(dealii::ArrayView<const double>(local, 2), communicator,
+                                      dealii::ArrayView<double>(global, 2));
+          max_speed = global[0];
+          if (parallel && global[1] >= resort_at)
+            {
+              {
+                dealii::TimerOutput::Scope scope(timer, "migrate points");
+                engine->store(points);
+                ++n_resorts;
+              }
+              if (balance())
+                engine->load(points);
+            }
+        }
         work_of_gravity += dt * sum(r.gravity_power, communicator);
         time += dt;
         ++step;
@@ -199,7 +249,23 @@ namespace mpm
     const double n_now = static_cast<double>(n_points_initial - n_removed);
     pcout << "dealii-mpm: done, t = " << time << " s after " << step << " steps in " << wall << " s wall ("
           << std::setprecision(3) << (n_now * step) / wall << " point-updates/s); " << n_removed
-          << " material point(s) left the grid and were removed.\n"
+          << " material point(s) left the grid and were removed.\n";
+    if (parallel)
+      pcout << "  MPI: " << n_resorts << " re-sorts of the points into cells and ranks, "
+            << static_cast<long>(sum(double(points.n_sent), communicator)) << " points migrated, "
+            << n_repartitions << " repartitions; work per rank max/mean " << points.imbalance() << "\n";
+    if (parallel)
+      {
+        // Ghost exchange per step: import + export of every ghost node's value, for each
+        // array the scheme sums (MUSL: mass, momentum, force, then momentum again).
+        const double ghosts = grid.partitioner->n_ghost_indices();
+        const int    arrays = parameters.scheme == UpdateScheme::musl ? 3 * dim + 1 : 2 * dim + 1;
+        const double bytes  = sum(double(grid.exchange_bytes_per_array()), communicator) * arrays;
+        pcout << "  MPI: ghost nodes " << static_cast<long>(sum(ghosts, communicator)) << " in all, "
+              << static_cast<long>(max(ghosts, communicator)) << " at most on one rank; exchange " << bytes
+              << " bytes per step (" << arrays << " nodal arrays, each ghost value sent to its owner and back)\n";
+      }
+    pcout
           << "  results: " << output.directory() << "/particles.pvd, " << output.directory()
           << "/grid.pvd, " << output.directory() << "/history.csv" << std::endl;
   }

@@ -2,6 +2,12 @@
 // Cartesian box, a Q1 DoFHandler whose vertex DoFs are the MPM nodes, nodal fields
 // as distributed vectors over the locally relevant DoFs, and the lattice lookup and
 // boundary masks that the core's GridView reads.
+//
+// In parallel, each rank's node arrays hold its locally relevant nodes: the vertices
+// of its locally owned cells and of the one layer of ghost cells around them (p4est's
+// ghost layer includes corner neighbours). A point whose centre lies in an owned cell,
+// or less than half a cell outside one, has its whole GIMP (and linear) stencil in this
+// set; the step loop keeps every point within that distance (doc/performance.md, MPI).
 #pragma once
 
 #include <mpm/core/views.h>
@@ -14,7 +20,7 @@
 #include <deal.II/fe/mapping_q1.h>
 #include <deal.II/lac/la_parallel_vector.h>
 
-#include <map>
+#include <array>
 #include <memory>
 #include <vector>
 
@@ -28,17 +34,24 @@ namespace mpm
 
     BackgroundGrid(const Parameters &parameters, MPI_Comm communicator);
 
+    // (Re)builds everything that depends on the partition: DoFs, the partitioner,
+    // the nodal vectors, the lattice lookups and the boundary masks. Called by the
+    // constructor and after every repartition of the triangulation.
+    void distribute_nodes();
+
     // Active cell of the triangulation at lattice cell index i + n_x (j + n_y k),
-    // or an invalid iterator where this rank does not own the cell.
+    // or triangulation.end() where this rank does not own the cell.
     typename dealii::Triangulation<dim>::active_cell_iterator owned_cell(long lattice_cell) const;
 
+    // Lattice cell index of the cell containing x (clamped to the grid).
     long lattice_cell_of(const double *x) const;
-
 
     mpm::GridView<dim, double> view();
 
-    // Sums ghost-node contributions to their owners and sends the sums back
-    // (deal.II's compress(add) + update_ghost_values). Called by the step.
+    // Sums ghost-node contributions to their owners and sends the sums back, on raw
+    // arrays laid out as the partitioner's local storage (owned nodes, then ghosts),
+    // through the Partitioner's import/export functions. Called by the step after
+    // each P2G pass; the arrays may later be device buffers (doc/performance.md, MPI).
     struct Exchange
     {
       const BackgroundGrid *grid;
@@ -50,7 +63,11 @@ namespace mpm
     };
     Exchange exchange() const { return Exchange{this}; }
 
+    // Bytes one rank sends per array in one sum_nodal (import + export of its ghosts).
+    std::size_t exchange_bytes_per_array() const;
+
     MPI_Comm                                  communicator;
+    unsigned int                              n_ranks;
     dealii::parallel::distributed::Triangulation<dim> triangulation;
     dealii::FE_Q<dim>                         fe;
     dealii::DoFHandler<dim>                   dof_handler;
@@ -66,12 +83,17 @@ namespace mpm
     Vector mass, momentum[dim], force[dim], velocity[dim];
 
   private:
-    void sum_nodal(double *const *arrays, int count) const;
-    void sum_nodal(float *const *, int) const {}
+    template <typename Real>
+    void sum_nodal(Real *const *arrays, int count) const;
 
+    std::array<BoundaryType, 6> boundary;
     std::vector<int>          lattice_to_node;
     std::vector<std::uint8_t> fixed_components;
     std::vector<typename dealii::Triangulation<dim>::active_cell_iterator> cell_of_lattice_cell;
-    std::map<const double *, Vector *> vector_of_array;
+
+    // Scratch of the exchange: import/export buffers and MPI requests per array.
+    mutable std::vector<double>                   buffer_double;
+    mutable std::vector<float>                    buffer_float;
+    mutable std::vector<std::vector<MPI_Request>> requests;
   };
 } // namespace mpm

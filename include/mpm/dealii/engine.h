@@ -8,6 +8,7 @@
 #include <mpm/core/step.h>
 #include <mpm/dealii/material_points.h>
 
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -23,6 +24,10 @@ namespace mpm
     virtual unsigned int            store(MaterialPoints<dim> &points)                = 0;
     virtual StepReduction<double>   step(const StepSettings<dim, double> &s, double dt) = 0;
     virtual PointTotals<dim, double> totals()                                         = 0;
+    // Largest distance of a point outside the cell it was sorted into at the last
+    // load/store, in cell units (max-norm); MPI runs re-sort before it gets unsafe.
+    // An engine that does not track it makes MPI runs re-sort after every step.
+    virtual double max_distance_outside_home_cells() { return std::numeric_limits<double>::infinity(); }
     // Replaces the material table (e.g. when plasticity is switched on).
     virtual void set_materials(const std::vector<MaterialParameters<double>> &materials) = 0;
   };

@@ -10,6 +10,8 @@
 #include <deal.II/numerics/data_component_interpretation.h>
 #include <deal.II/particles/particle_handler.h>
 
+#include <boost/signals2/connection.hpp>
+
 #include <string>
 #include <vector>
 
@@ -41,23 +43,39 @@ namespace mpm
   class MaterialPoints
   {
   public:
+    // Also connects the cell weights of the load balance (Parallel/Point weight) to
+    // the triangulation.
     MaterialPoints(BackgroundGrid<dim> &grid, const Parameters &parameters);
 
     // Fills the handler with the points of every body inside this rank's cells.
     void generate(const Parameters &parameters);
 
-    // Handler -> core arrays (after generation and after every re-sort).
-    void copy_to(HostPoints<dim, double> &points) const;
+    // Handler -> core arrays (after generation and after every re-sort). If home_cells
+    // is given, it receives the lattice index of each point's (locally owned) cell.
+    void copy_to(HostPoints<dim, double> &points, std::vector<long> *home_cells = nullptr) const;
 
     // Core arrays -> handler: positions and properties; points the core marked as
     // having left the grid are removed. Then the handler re-sorts points into cells
-    // (and ranks). Returns the number of points removed on this rank.
+    // and ranks (points now in another rank's cell migrate there with all their
+    // properties). Returns the number of points removed on this rank.
     unsigned int copy_from(const HostPoints<dim, double> &points);
+
+    // Largest work of one rank over the mean (1 = perfectly balanced), work being the
+    // partition's weights: owned cells + Point weight x owned points.
+    double imbalance() const;
+
+    // Repartitions the triangulation by work (cell weight 1 + Point weight x points in
+    // the cell), moves the points with their cells, and rebuilds the grid's nodes.
+    void repartition();
 
     dealii::Particles::ParticleHandler<dim> handler;
     dealii::types::particle_index           n_generated = 0;
+    // Points this rank handed to another rank in copy_from's re-sorts, summed.
+    unsigned long n_sent = 0;
 
   private:
     BackgroundGrid<dim> &grid;
+    double                             point_weight;
+    boost::signals2::scoped_connection weight_connection;
   };
 } // namespace mpm

@@ -74,6 +74,12 @@ namespace mpm
     bool         write_particles;
     unsigned int history_every;
     double       progress_interval;
+    bool         write_particle_table;
+
+    // Parallel runs (doc/performance.md, MPI)
+    double resort_distance;        // re-sort at this fraction of the safe distance outside a home cell
+    double load_balance_threshold; // repartition when max/mean work per rank exceeds it; 0 = never
+    double point_weight;           // work of one point relative to one empty cell
 
     // Backend
     std::string backend;

@@ -1,0 +1,42 @@
+// How far a point has moved out of its "home" cell, the cell it was sorted into when
+// the deal.II layer last handed the points to the backend. In parallel runs the
+// owning rank has every node of a point's stencil only while the point is less than
+// a shape-dependent distance outside its home cell (half a cell for GIMP, one cell
+// for linear; doc/performance.md, MPI); the step loop re-sorts the points into cells
+// and ranks before any point gets that far.
+#pragma once
+
+#include <mpm/core/shape_functions.h>
+#include <mpm/core/views.h>
+
+namespace mpm
+{
+  // Largest distance outside its home cell, in cell units and max-norm, such that
+  // the point's stencil still lies in the home cell's vertices and the ring of
+  // nodes around them (the vertices of the home cell's neighbours).
+  inline double safe_distance_outside_home_cell(const ShapeFunction shape)
+  {
+    // GIMP: stencil first node floor(s + 1/2) - 1, three nodes; linear: floor(s), two.
+    return shape == ShapeFunction::gimp ? 0.5 : 1.0;
+  }
+
+  // Distance of point i outside its home cell (0 inside), in cell units, max-norm.
+  // home_cell is the lattice cell index i + n_x (j + n_y k).
+  template <int dim, typename Real>
+  MPM_HOST_DEVICE inline Real distance_outside_home_cell(const Real origin[dim], const Real h,
+                                                         const int n_cells[dim], const Real *const position[dim],
+                                                         const long home_cell, const int i)
+  {
+    long c        = home_cell;
+    Real distance = Real(0);
+    for (int d = 0; d < dim; ++d)
+      {
+        const long lower = c % n_cells[d];
+        c /= n_cells[d];
+        const Real s       = (position[d][i] - origin[d]) / h - Real(lower);
+        const Real outside = s < Real(0) ? -s : (s > Real(1) ? s - Real(1) : Real(0));
+        distance           = outside > distance ? outside : distance;
+      }
+    return distance;
+  }
+} // namespace mpm

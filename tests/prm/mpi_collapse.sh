@@ -1,0 +1,12 @@
+#!/bin/bash
+# Reduced V3 collapse (collapse_small_2d.prm) on 1, 2 and 4 MPI ranks, with a low load
+# balance threshold. Asserts: final positions and stresses np-invariant to 1e-10
+# (relative to the field's magnitude); on 4 ranks points migrate (counts per rank
+# change, total conserved) and the grid is repartitioned by work.
+# Usage: mpi_collapse.sh EXE SOURCE_DIR OUTDIR
+set -eu
+exe=$1 src=$2 out=$3 here=$(dirname "$0")
+bash "$here/run_np.sh" "$exe" "$here/collapse_small_2d.prm" "$out" "1 2 4" \
+  "subsection Parallel" "  set Load balance threshold = 1.02" "end"
+/usr/bin/python3 "$here/compare_np.py" "$out/np1" "$out/np2" "$out/np4" --rtol 1e-10
+/usr/bin/python3 "$here/compare_np.py" "$out/np1" "$out/np4" --rtol 1e-10 --migrated --repartitioned
