@@ -167,7 +167,7 @@ def draw(result, png, title, reference):
         xr = np.array([0.0, 0.45])
         ax.plot(xr, 0.099 - math.tan(math.radians(14)) * xr, color="C3", lw=0.8, ls="-.",
                 label="14 deg from 0.099 m (experiment)")
-    ax.set_xlim(-0.005, max(result["farthest_point"], result["toe"]) + 0.01)
+    ax.set_xlim(-0.005, max(result["farthest_point"], result["toe"], 0.46 if reference else 0) + 0.01)
     ax.set_ylim(-0.005, max(result["max_height"], 0.01) * 1.15)
     ax.set_aspect("equal")
     ax.set_xlabel("distance from the wall x (m)")
