@@ -1,5 +1,6 @@
 #include <mpm/core/backend/cpu_backend.h>
 #include <mpm/core/migration.h>
+#include <mpm/dealii/cuda_engine.h>
 #include <mpm/dealii/engine.h>
 
 #include <deal.II/base/exceptions.h>
@@ -86,6 +87,8 @@ namespace mpm
   {
     if (backend == "cpu")
       return std::make_unique<CpuEngine<dim>>(grid, materials, shape);
+    if (backend == "cuda")
+      return make_cuda_engine<dim>(grid, materials, shape); // throws where not available
     AssertThrow(false, dealii::ExcMessage("Parameter 'Backend/Backend': '" + backend +
                                           "' is not available in this build (allowed here: cpu). Build with "
                                           "-DMPM_WITH_CUDA=ON for cuda."));

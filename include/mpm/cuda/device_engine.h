@@ -1,0 +1,76 @@
+// The whole explicit step on a CUDA device, behind a plain C++ interface that host
+// code compiled by an ordinary C++ compiler can use: no CUDA and no deal.II header
+// here. The implementation (source/cuda/device_engine.cu, compiled by nvcc into the
+// static library mpm_cuda_engine) keeps the points and nodes in device memory for
+// the whole run; data crosses to the host only in upload/download (output, end of
+// run, later MPI migration) and as the few bytes of each step's reduction.
+//
+// The host grid description is a GridView<dim, double> whose geometry, lattice
+// lookup (lattice_to_node) and boundary masks (fixed_components) are read once at
+// construction; its nodal arrays are written only by download_nodal().
+#pragma once
+
+#include <mpm/core/diagnostics.h>
+#include <mpm/core/host_storage.h>
+#include <mpm/core/material/material.h>
+#include <mpm/core/shape_functions.h>
+#include <mpm/core/step.h>
+#include <mpm/core/views.h>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace mpm
+{
+  namespace cuda
+  {
+    // Number of CUDA devices usable by this process (0 where there is none or no
+    // driver); on 0, `why` says what the runtime reported.
+    int device_count(std::string *why = nullptr);
+
+    // Name, compute capability and memory of the current device, for the log.
+    std::string device_description();
+
+    // Where ranks will sum their ghost-node contributions on device buffers, between
+    // a P2G pass and the nodal update (the MPI engineer's hook). The arrays are device
+    // pointers, each n_nodes long, laid out as the host grid's node numbering.
+    class NodalExchange
+    {
+    public:
+      virtual ~NodalExchange()                                                        = default;
+      virtual void sum_nodal(double *const *device_arrays, int count, int n_nodes) = 0;
+    };
+
+    template <int dim>
+    class DeviceEngine
+    {
+    public:
+      // exchange: null on one rank (no ghost nodes).
+      DeviceEngine(const GridView<dim, double> &host_grid, const std::vector<MaterialParameters<double>> &materials,
+                   ShapeFunction shape, NodalExchange *exchange = nullptr);
+      ~DeviceEngine();
+      DeviceEngine(const DeviceEngine &)            = delete;
+      DeviceEngine &operator=(const DeviceEngine &) = delete;
+
+      // Host -> device: the whole point set (its size may have changed).
+      void upload_points(const HostPoints<dim, double> &points);
+      // Device -> host: every point array (points that left the grid have material < 0).
+      void download_points(HostPoints<dim, double> &points) const;
+      // Device -> host: nodal mass, momentum, force and velocity into the host grid's
+      // arrays (same numbering and length as at construction).
+      void download_nodal(const GridView<dim, double> &host_grid) const;
+
+      // One step on the device; only the reduction (max speed, power of gravity) comes back.
+      StepReduction<double> step(const StepSettings<dim, double> &settings, double dt);
+      PointTotals<dim, double> totals();
+      void set_materials(const std::vector<MaterialParameters<double>> &materials);
+
+      int n_points() const;
+
+    private:
+      struct Impl;
+      std::unique_ptr<Impl> impl;
+    };
+  } // namespace cuda
+} // namespace mpm

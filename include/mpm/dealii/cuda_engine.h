@@ -1,0 +1,16 @@
+// Backend = cuda: the Engine<dim> (engine.h) over mpm::cuda::DeviceEngine, whose
+// points and nodes stay in device memory for the whole run.
+#pragma once
+
+#include <mpm/dealii/engine.h>
+
+namespace mpm
+{
+  // Throws naming Backend/Backend where this build has no CUDA engine
+  // (configured without -DMPM_WITH_CUDA=ON), where no CUDA device is found, or on
+  // more than one MPI rank (not supported by the CUDA engine yet).
+  template <int dim>
+  std::unique_ptr<Engine<dim>> make_cuda_engine(BackgroundGrid<dim> &grid,
+                                                const std::vector<MaterialParameters<double>> &materials,
+                                                ShapeFunction shape);
+} // namespace mpm

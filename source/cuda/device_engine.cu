@@ -1,0 +1,197 @@
+// nvcc side of mpm::cuda::DeviceEngine (include/mpm/cuda/device_engine.h): the core's
+// step.h run by CudaBackend over DevicePoints / DeviceGrid (backend/cuda_storage.h).
+// Includes core headers only, never deal.II.
+#include <mpm/core/backend/cuda_backend.h>
+#include <mpm/core/backend/cuda_storage.h>
+#include <mpm/cuda/device_engine.h>
+
+#include <cstdio>
+#include <stdexcept>
+#include <type_traits>
+#include <utility>
+
+namespace mpm
+{
+  namespace cuda
+  {
+    int device_count(std::string *why)
+    {
+      int               n    = 0;
+      const cudaError_t code = cudaGetDeviceCount(&n);
+      if (code != cudaSuccess)
+        {
+          if (why)
+            *why = std::string(cudaGetErrorName(code)) + ": " + cudaGetErrorString(code);
+          (void)cudaGetLastError();
+          return 0;
+        }
+      if (n == 0 && why)
+        *why = "the CUDA runtime found no device";
+      return n;
+    }
+
+    std::string device_description()
+    {
+      int device = 0;
+      MPM_CUDA_CHECK(cudaGetDevice(&device));
+      cudaDeviceProp prop;
+      MPM_CUDA_CHECK(cudaGetDeviceProperties(&prop, device));
+      char text[256];
+      std::snprintf(text, sizeof(text), "%s (sm_%d%d, %d SMs, %.1f GB)", prop.name, prop.major, prop.minor,
+                    prop.multiProcessorCount, prop.totalGlobalMem / 1e9);
+      return text;
+    }
+
+    namespace
+    {
+      // The step's exchange hook: nothing on one rank, the NodalExchange otherwise.
+      struct ExchangeAdapter
+      {
+        NodalExchange *exchange;
+        int            n_nodes;
+        template <typename Real>
+        void sum_nodal(Real *const *arrays, const int count) const
+        {
+          static_assert(std::is_same<Real, double>::value, "the engine runs in double");
+          if (exchange != nullptr)
+            exchange->sum_nodal(arrays, count, n_nodes);
+        }
+      };
+
+      // Cell arrays of the pressure averaging, where this version of GridView has them.
+      template <typename G, typename = void>
+      struct HasCellArrays : std::false_type
+      {};
+      template <typename G>
+      struct HasCellArrays<G, decltype((void)std::declval<G &>().cell_volume, void())> : std::true_type
+      {};
+
+      template <typename G>
+      void set_cell_arrays(G &g, double *volume, double *pressure_volume, std::true_type)
+      {
+        g.cell_volume          = volume;
+        g.cell_pressure_volume = pressure_volume;
+      }
+      template <typename G>
+      void set_cell_arrays(G &, double *, double *, std::false_type)
+      {}
+    } // namespace
+
+    template <int dim>
+    struct DeviceEngine<dim>::Impl
+    {
+      CudaBackend                  backend;
+      DeviceGrid<dim, double>      grid;
+      DevicePoints<dim, double>    points;
+      DeviceMaterials<double>      materials;
+      DeviceArray<double>          cell_volume, cell_pressure_volume;
+      long                         n_lattice_cells = 1;
+      ShapeFunction                shape;
+      ExchangeAdapter              exchange;
+    };
+
+    template <int dim>
+    DeviceEngine<dim>::DeviceEngine(const GridView<dim, double> &g,
+                                    const std::vector<MaterialParameters<double>> &materials, const ShapeFunction shape,
+                                    NodalExchange *exchange)
+    {
+      std::string why;
+      if (device_count(&why) == 0)
+        throw std::runtime_error("no CUDA device: " + why);
+      impl        = std::make_unique<Impl>();
+      impl->shape = shape;
+      // The host grid description: geometry, lookup and masks, nodal arrays zeroed.
+      HostGrid<dim, double> host;
+      host.h   = g.h;
+      long n_lattice_nodes = 1;
+      for (int d = 0; d < dim; ++d)
+        {
+          host.origin[d]  = g.origin[d];
+          host.n_cells[d] = g.n_cells[d];
+          n_lattice_nodes *= g.n_cells[d] + 1;
+          impl->n_lattice_cells *= g.n_cells[d];
+        }
+      host.lattice_to_node.assign(g.lattice_to_node, g.lattice_to_node + n_lattice_nodes);
+      host.allocate_nodes(g.n_nodes);
+      host.fixed_components.assign(g.fixed_components, g.fixed_components + g.n_nodes);
+      impl->grid.upload(host);
+      impl->materials.upload(materials);
+      impl->exchange = ExchangeAdapter{exchange, g.n_nodes};
+    }
+
+    template <int dim>
+    DeviceEngine<dim>::~DeviceEngine() = default;
+
+    template <int dim>
+    void DeviceEngine<dim>::upload_points(const HostPoints<dim, double> &p)
+    {
+      impl->points.upload(p);
+    }
+
+    template <int dim>
+    void DeviceEngine<dim>::download_points(HostPoints<dim, double> &p) const
+    {
+      impl->backend.synchronize();
+      impl->points.download(p);
+    }
+
+    template <int dim>
+    void DeviceEngine<dim>::download_nodal(const GridView<dim, double> &g) const
+    {
+      impl->backend.synchronize();
+      const DeviceGrid<dim, double> &dg = impl->grid;
+      const size_t bytes = dg.mass.bytes();
+      if (static_cast<size_t>(g.n_nodes) != dg.mass.size())
+        throw std::invalid_argument("DeviceEngine::download_nodal: the host grid has another number of nodes");
+      MPM_CUDA_CHECK(cudaMemcpy(g.mass, dg.mass.data(), bytes, cudaMemcpyDeviceToHost));
+      for (int d = 0; d < dim; ++d)
+        {
+          MPM_CUDA_CHECK(cudaMemcpy(g.momentum[d], dg.momentum[d].data(), bytes, cudaMemcpyDeviceToHost));
+          MPM_CUDA_CHECK(cudaMemcpy(g.force[d], dg.force[d].data(), bytes, cudaMemcpyDeviceToHost));
+          MPM_CUDA_CHECK(cudaMemcpy(g.velocity[d], dg.velocity[d].data(), bytes, cudaMemcpyDeviceToHost));
+        }
+    }
+
+    template <int dim>
+    StepReduction<double> DeviceEngine<dim>::step(const StepSettings<dim, double> &s, const double dt)
+    {
+      GridView<dim, double> g = impl->grid.view();
+      if (s.pressure_averaging)
+        {
+          if (!HasCellArrays<GridView<dim, double>>::value)
+            throw std::runtime_error("pressure averaging is not available in this build of the CUDA engine");
+          if (impl->cell_volume.size() == 0)
+            {
+              impl->cell_volume.resize(impl->n_lattice_cells);
+              impl->cell_pressure_volume.resize(impl->n_lattice_cells);
+            }
+          set_cell_arrays(g, impl->cell_volume.data(), impl->cell_pressure_volume.data(),
+                          HasCellArrays<GridView<dim, double>>());
+        }
+      return explicit_step<dim>(impl->backend, impl->shape, g, impl->points.view(), impl->materials.data(), s, dt,
+                                impl->exchange);
+    }
+
+    template <int dim>
+    PointTotals<dim, double> DeviceEngine<dim>::totals()
+    {
+      return point_totals<dim>(impl->backend, impl->points.view());
+    }
+
+    template <int dim>
+    void DeviceEngine<dim>::set_materials(const std::vector<MaterialParameters<double>> &materials)
+    {
+      impl->backend.synchronize(); // the table may be in use by a launch in flight
+      impl->materials.upload(materials);
+    }
+
+    template <int dim>
+    int DeviceEngine<dim>::n_points() const
+    {
+      return impl->points.size();
+    }
+
+    template class DeviceEngine<2>;
+    template class DeviceEngine<3>;
+  } // namespace cuda
+} // namespace mpm
