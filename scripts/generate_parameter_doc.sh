@@ -1,8 +1,10 @@
 #!/bin/bash
 # Regenerates doc/parameters.md from the program itself (every entry, default and documentation).
+# Usage: generate_parameter_doc.sh [EXE] [OUTPUT]   (OUTPUT "-" = standard output)
 set -euo pipefail
 cd "$(dirname "$0")/.."
-exe=${1:-build/dealii-mpm}
+exe=$(realpath "${1:-build/dealii-mpm}")
+target=${2:-doc/parameters.md}
 {
   echo "# Parameter reference"
   echo
@@ -19,5 +21,5 @@ exe=${1:-build/dealii-mpm}
     echo '```'
     echo
   done
-} > doc/parameters.md
-echo "wrote doc/parameters.md"
+} > "${target/#-//dev/stdout}"
+[ "$target" = "-" ] || echo "wrote $target"

@@ -140,7 +140,7 @@ namespace mpm
       settings.mass_tolerance = 1e-12 * min(m_min, communicator);
     }
 
-    double time = 0, max_speed = 0, work_of_gravity = 0, dt = 0;
+    double time = 0, max_speed = 0, max_removed_speed = 0, work_of_gravity = 0, dt = 0;
     long   step = 0, n_removed = 0;
     double next_output = parameters.output_interval;
     auto   last_progress = std::chrono::steady_clock::now();
@@ -196,10 +196,13 @@ namespace mpm
         // One reduction for the next time step and the migration test: the largest
         // speed and the largest distance of a point outside its home cell.
         {
-          double local[2] = {r.max_speed, parallel ? engine->max_distance_outside_home_cells() : 0.0}, global[2];
-          dealii::Utilities::MPI::max(dealii::ArrayView<const double>(local, 2), communicator,
-                                      dealii::ArrayView<double>(global, 2));
-          max_speed = global[0];
+          double local[3] = {r.max_speed, parallel ? engine->max_distance_outside_home_cells() : 0.0,
+                             r.max_removed_speed},
+                 global[3];
+          dealii::Utilities::MPI::max(dealii::ArrayView<const double>(local, 3), communicator,
+                                      dealii::ArrayView<double>(global, 3));
+          max_speed         = global[0];
+          max_removed_speed = global[2];
           if (parallel && global[1] >= resort_at)
             {
               {
@@ -214,10 +217,15 @@ namespace mpm
         work_of_gravity += dt * sum(r.gravity_power, communicator);
         time += dt;
         ++step;
-        AssertThrow(std::isfinite(max_speed),
+        // A blow-up shows as a non-finite velocity or, with the adaptive step, as speeds that
+        // shrink dt by orders of magnitude: stop with a message instead of crawling on.
+        const double fastest = std::max(max_speed, max_removed_speed);
+        AssertThrow(std::isfinite(max_speed) && std::isfinite(max_removed_speed) && fastest <= 1000 * c_el,
                     dealii::ExcMessage("The simulation became unstable at t = " + dealii::Utilities::to_string(time) +
-                                       " s (step " + std::to_string(step) +
-                                       "): a velocity is not finite. Reduce 'Solver/CFL number' or the time step."));
+                                       " s (step " + std::to_string(step) + "): a material point moves at " +
+                                       dealii::Utilities::to_string(fastest) +
+                                       " m/s, more than 1000 times the elastic wave speed. Reduce 'Solver/CFL "
+                                       "number' or the time step, or use GIMP shape functions."));
 
         if (step % parameters.history_every == 0)
           record_history();

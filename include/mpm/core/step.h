@@ -54,6 +54,8 @@ namespace mpm
   {
     Real max_speed;
     Real gravity_power;
+    Real max_removed_speed; // speed of points that left the grid, frozen when they left:
+                            // a blow-up that throws points out must not pass unnoticed
   };
 
   // Hooks between a P2G pass and the nodal update, where ranks sum their ghost
@@ -406,26 +408,29 @@ namespace mpm
     StepReduction<Real> reduce_step(Backend &backend, const PointsView<dim, Real> &p,
                                     const StepSettings<dim, Real> &s)
     {
-      StepReduction<Real> init{Real(0), Real(0)};
+      StepReduction<Real> init{Real(0), Real(0), Real(0)};
       return backend.reduce_points(
         p.n_points, init,
         [=] MPM_HOST_DEVICE(const int i) {
-          StepReduction<Real> r{Real(0), Real(0)};
-          if (p.material[i] < 0)
-            return r;
+          StepReduction<Real> r{Real(0), Real(0), Real(0)};
           Real v2 = Real(0);
           for (int d = 0; d < dim; ++d)
+            v2 += p.velocity[d][i] * p.velocity[d][i];
+          if (p.material[i] < 0)
             {
-              const Real v = p.velocity[d][i];
-              v2 += v * v;
-              r.gravity_power += p.mass[i] * s.gravity[d] * v;
+              r.max_removed_speed = std::sqrt(v2);
+              return r;
             }
+          for (int d = 0; d < dim; ++d)
+            r.gravity_power += p.mass[i] * s.gravity[d] * p.velocity[d][i];
           r.max_speed = std::sqrt(v2);
           return r;
         },
         [] MPM_HOST_DEVICE(const StepReduction<Real> &a, const StepReduction<Real> &b) {
           return StepReduction<Real>{a.max_speed > b.max_speed ? a.max_speed : b.max_speed,
-                                     a.gravity_power + b.gravity_power};
+                                     a.gravity_power + b.gravity_power,
+                                     a.max_removed_speed > b.max_removed_speed ? a.max_removed_speed :
+                                                                                 b.max_removed_speed};
         });
     }
   } // namespace stages
