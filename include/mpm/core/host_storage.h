@@ -9,6 +9,35 @@
 
 namespace mpm
 {
+  // The view of any owner of point arrays (HostPoints, the CUDA backend's DevicePoints):
+  // arrays with .data() under the member names of HostPoints.
+  template <int dim, typename Real, typename Storage>
+  PointsView<dim, Real> make_points_view(Storage &s)
+  {
+    PointsView<dim, Real> v;
+    v.n_points = s.size();
+    for (int d = 0; d < dim; ++d)
+      {
+        v.position[d]                   = s.position[d].data();
+        v.velocity[d]                   = s.velocity[d].data();
+        v.domain_half_length[d]         = s.domain_half_length[d].data();
+        v.initial_domain_half_length[d] = s.initial_domain_half_length[d].data();
+      }
+    for (int c = 0; c < n_voigt; ++c)
+      {
+        v.stress[c] = s.stress[c].data();
+        v.strain[c] = s.strain[c].data();
+      }
+    for (int c = 0; c < dim * dim; ++c)
+      v.deformation_gradient[c] = s.deformation_gradient[c].data();
+    v.mass           = s.mass.data();
+    v.volume         = s.volume.data();
+    v.initial_volume = s.initial_volume.data();
+    v.plastic_strain = s.plastic_strain.data();
+    v.material       = s.material.data();
+    return v;
+  }
+
   template <int dim, typename Real>
   struct HostPoints
   {
@@ -41,31 +70,7 @@ namespace mpm
       material.resize(n);
     }
 
-    PointsView<dim, Real> view()
-    {
-      PointsView<dim, Real> v;
-      v.n_points = size();
-      for (int d = 0; d < dim; ++d)
-        {
-          v.position[d]                   = position[d].data();
-          v.velocity[d]                   = velocity[d].data();
-          v.domain_half_length[d]         = domain_half_length[d].data();
-          v.initial_domain_half_length[d] = initial_domain_half_length[d].data();
-        }
-      for (int c = 0; c < n_voigt; ++c)
-        {
-          v.stress[c] = stress[c].data();
-          v.strain[c] = strain[c].data();
-        }
-      for (int c = 0; c < dim * dim; ++c)
-        v.deformation_gradient[c] = deformation_gradient[c].data();
-      v.mass           = mass.data();
-      v.volume         = volume.data();
-      v.initial_volume = initial_volume.data();
-      v.plastic_strain = plastic_strain.data();
-      v.material       = material.data();
-      return v;
-    }
+    PointsView<dim, Real> view() { return make_points_view<dim, Real>(*this); }
   };
 
   template <int dim, typename Real>

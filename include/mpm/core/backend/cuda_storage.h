@@ -146,31 +146,7 @@ namespace mpm
       return (4 * dim + 4 + 2 * n_voigt + dim * dim) * sizeof(Real) + sizeof(int);
     }
 
-    PointsView<dim, Real> view()
-    {
-      PointsView<dim, Real> v;
-      v.n_points = size();
-      for (int d = 0; d < dim; ++d)
-        {
-          v.position[d]                   = position[d].data();
-          v.velocity[d]                   = velocity[d].data();
-          v.domain_half_length[d]         = domain_half_length[d].data();
-          v.initial_domain_half_length[d] = initial_domain_half_length[d].data();
-        }
-      for (int c = 0; c < n_voigt; ++c)
-        {
-          v.stress[c] = stress[c].data();
-          v.strain[c] = strain[c].data();
-        }
-      for (int c = 0; c < dim * dim; ++c)
-        v.deformation_gradient[c] = deformation_gradient[c].data();
-      v.mass           = mass.data();
-      v.volume         = volume.data();
-      v.initial_volume = initial_volume.data();
-      v.plastic_strain = plastic_strain.data();
-      v.material       = material.data();
-      return v;
-    }
+    PointsView<dim, Real> view() { return make_points_view<dim, Real>(*this); }
   };
 
   template <int dim, typename Real>
