@@ -73,6 +73,34 @@ namespace mpm
     PointsView<dim, Real> view() { return make_points_view<dim, Real>(*this); }
   };
 
+  // The view of any owner of grid arrays (HostGrid, the CUDA backend's DeviceGrid):
+  // arrays with .data() and .size() under the member names of HostGrid. The cell arrays
+  // of the pressure averaging are optional (empty: null in the view).
+  template <int dim, typename Real, typename Storage>
+  GridView<dim, Real> make_grid_view(Storage &s)
+  {
+    GridView<dim, Real> v;
+    for (int d = 0; d < dim; ++d)
+      {
+        v.origin[d]   = s.origin[d];
+        v.n_cells[d]  = s.n_cells[d];
+        v.momentum[d] = s.momentum[d].data();
+        v.force[d]    = s.force[d].data();
+        v.velocity[d] = s.velocity[d].data();
+      }
+    v.h                = s.h;
+    v.lattice_to_node  = s.lattice_to_node.data();
+    v.n_nodes          = static_cast<int>(s.mass.size());
+    v.mass             = s.mass.data();
+    v.fixed_components = s.fixed_components.data();
+    if (s.cell_volume.size() > 0)
+      {
+        v.cell_volume          = s.cell_volume.data();
+        v.cell_pressure_volume = s.cell_pressure_volume.data();
+      }
+    return v;
+  }
+
   template <int dim, typename Real>
   struct HostGrid
   {
@@ -134,28 +162,6 @@ namespace mpm
         }
     }
 
-    GridView<dim, Real> view()
-    {
-      GridView<dim, Real> v;
-      for (int d = 0; d < dim; ++d)
-        {
-          v.origin[d]   = origin[d];
-          v.n_cells[d]  = n_cells[d];
-          v.momentum[d] = momentum[d].data();
-          v.force[d]    = force[d].data();
-          v.velocity[d] = velocity[d].data();
-        }
-      v.h                = h;
-      v.lattice_to_node  = lattice_to_node.data();
-      v.n_nodes          = static_cast<int>(mass.size());
-      v.mass             = mass.data();
-      v.fixed_components = fixed_components.data();
-      if (!cell_volume.empty())
-        {
-          v.cell_volume          = cell_volume.data();
-          v.cell_pressure_volume = cell_pressure_volume.data();
-        }
-      return v;
-    }
+    GridView<dim, Real> view() { return make_grid_view<dim, Real>(*this); }
   };
 } // namespace mpm

@@ -158,6 +158,7 @@ namespace mpm
     DeviceArray<int>          lattice_to_node;
     DeviceArray<Real>         mass, momentum[dim], force[dim], velocity[dim];
     DeviceArray<std::uint8_t> fixed_components;
+    DeviceArray<Real>         cell_volume, cell_pressure_volume; // pressure averaging; empty unless resized
 
     int n_nodes() const { return static_cast<int>(mass.size()); }
 
@@ -190,24 +191,7 @@ namespace mpm
       mass.download(g.mass);
     }
 
-    GridView<dim, Real> view()
-    {
-      GridView<dim, Real> v;
-      for (int d = 0; d < dim; ++d)
-        {
-          v.origin[d]   = origin[d];
-          v.n_cells[d]  = n_cells[d];
-          v.momentum[d] = momentum[d].data();
-          v.force[d]    = force[d].data();
-          v.velocity[d] = velocity[d].data();
-        }
-      v.h                = h;
-      v.lattice_to_node  = lattice_to_node.data();
-      v.n_nodes          = n_nodes();
-      v.mass             = mass.data();
-      v.fixed_components = fixed_components.data();
-      return v;
-    }
+    GridView<dim, Real> view() { return make_grid_view<dim, Real>(*this); }
   };
 
   // The material table the constitutive update indexes by p.material[i].
