@@ -1,9 +1,12 @@
 #include <mpm/core/point_generation.h>
 #include <mpm/dealii/material_points.h>
+#include <mpm/fields/gaussian_random_field.h>
 
 #include <deal.II/base/mpi.h>
 
 #include <cmath>
+#include <map>
+#include <memory>
 
 namespace mpm
 {
@@ -30,6 +33,7 @@ namespace mpm
     n.push_back("material_id");
     for (int d = 0; d < dim; ++d)
       n.push_back("initial_position");
+    n.push_back("material_field");
     return n;
   }
 
@@ -102,6 +106,23 @@ namespace mpm
         lattice.n_cells[d] = grid.n_cells[d];
       }
 
+    // Random fields of material parameters, one per material that has one, over the grid.
+    std::map<unsigned int, std::unique_ptr<GaussianRandomField<dim>>> fields;
+    for (unsigned int m = 0; m < parameters.materials.size(); ++m)
+      if (parameters.materials[m].field_parameter != FieldParameter::none)
+        {
+          const RandomFieldParameters &rf = parameters.material_fields[m];
+          std::array<double, dim>      lo, hi;
+          double                       spacing = grid.h;
+          for (int d = 0; d < dim; ++d)
+            {
+              lo[d]   = grid.origin[d];
+              hi[d]   = grid.origin[d] + grid.n_cells[d] * grid.h;
+              spacing = std::min(spacing, rf.correlation_length[d] / 4);
+            }
+          fields[m] = std::make_unique<GaussianRandomField<dim>>(rf, lo, hi, spacing);
+        }
+
     dealii::types::particle_index id = 0;
     for (unsigned int b = 0; b < parameters.bodies.size(); ++b)
       {
@@ -168,6 +189,15 @@ namespace mpm
                 properties[Layout::stress + 2] = dim == 2 ? body.k0 * sv : sv;
               }
             properties[Layout::material] = parameters.body_material[b];
+            if (const auto field = fields.find(parameters.body_material[b]); field != fields.end())
+              {
+                std::array<double, dim> xa;
+                for (int d = 0; d < dim; ++d)
+                  xa[d] = x[d];
+                // A Gaussian field can go below zero: cohesion and modulus are kept positive.
+                const double v = field->second->value(xa);
+                properties[Layout::material_field] = std::max(v, 1e-3 * std::abs(parameters.material_fields[field->first].mean));
+              }
 
             dealii::Point<dim> location;
             for (int d = 0; d < dim; ++d)
@@ -221,6 +251,7 @@ namespace mpm
         p.volume[i]         = prop[Layout::volume];
         p.initial_volume[i] = prop[Layout::initial_volume];
         p.plastic_strain[i] = prop[Layout::plastic_strain];
+        p.material_field[i] = prop[Layout::material_field];
         p.material[i]       = static_cast<int>(prop[Layout::material]);
         ++i;
       }

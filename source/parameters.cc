@@ -147,6 +147,19 @@ namespace mpm
             plugin.declare_parameters(prm);
             prm.leave_subsection();
           }
+        prm.enter_subsection("Random field");
+        prm.declare_entry("Parameter", "none", Patterns::Selection("none|cohesion|friction angle|Young's modulus"),
+                          "Material parameter that varies in space as a stationary Gaussian random field sampled at "
+                          "the points; its mean is the value given in the model's subsection (cohesion and friction "
+                          "angle need a plastic model). Cohesion keeps c_res/c, friction angle keeps phi - phi_res.");
+        prm.declare_entry("Covariance", "gaussian", Patterns::Selection("gaussian|exponential"),
+                          "gaussian: C(r) = s^2 exp(-sum (r_d/L_d)^2); exponential: C(r) = s^2 exp(-|r/L|).");
+        prm.declare_entry("Correlation lengths", ones(dim), point_pattern(dim),
+                          "Correlation length L_d along each axis (m, > 0).");
+        prm.declare_entry("Standard deviation", "0", Patterns::Double(0),
+                          "Standard deviation s, in the parameter's prm unit (Pa, degrees).");
+        prm.declare_entry("Seed", "1", Patterns::Integer(0), "Seed of the random numbers (same seed, same field).");
+        prm.leave_subsection();
         prm.leave_subsection();
       }
 
@@ -302,6 +315,42 @@ namespace mpm
             fail("Material " + name + "/" + model, info.str());
           }
         prm.leave_subsection();
+
+        // The random field: its mean is the material's own value of the parameter.
+        prm.enter_subsection("Random field");
+        const std::string  field = prm.get("Parameter");
+        const std::string  where = "Material " + name + "/Random field/";
+        MaterialParameters<double> &m = materials.back();
+        RandomFieldParameters       rf;
+        rf.covariance         = prm.get("Covariance") == "exponential" ? Covariance::exponential : Covariance::gaussian;
+        rf.correlation_length = get_point(prm, "Correlation lengths");
+        rf.standard_deviation = prm.get_double("Standard deviation");
+        rf.seed               = prm.get_integer("Seed");
+        for (const double L : rf.correlation_length)
+          if (!(L > 0))
+            fail(where + "Correlation lengths", "every correlation length must be > 0.");
+        const SofteningStrength<double> *strength =
+          m.model == MaterialModel::drucker_prager ? &m.drucker_prager.strength :
+          m.model == MaterialModel::mohr_coulomb   ? &m.mohr_coulomb.strength :
+                                                     nullptr;
+        if (field == "cohesion" || field == "friction angle")
+          {
+            if (strength == nullptr)
+              fail(where + "Parameter", "'" + field + "' needs a plastic model (drucker prager or mohr coulomb), "
+                                        "not '" + model + "'.");
+            m.field_parameter = field == "cohesion" ? FieldParameter::cohesion : FieldParameter::friction_angle;
+            rf.mean           = field == "cohesion" ? strength->cohesion : strength->friction_angle;
+            if (field == "friction angle")
+              rf.standard_deviation *= M_PI / 180;
+          }
+        else if (field == "Young's modulus")
+          {
+            m.field_parameter = FieldParameter::youngs_modulus;
+            rf.mean           = m.elastic.youngs_modulus;
+          }
+        material_fields.push_back(rf);
+        prm.leave_subsection();
+
         prm.leave_subsection();
         material_models.push_back(model);
       }

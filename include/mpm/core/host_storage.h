@@ -34,6 +34,7 @@ namespace mpm
     v.volume         = s.volume.data();
     v.initial_volume = s.initial_volume.data();
     v.plastic_strain = s.plastic_strain.data();
+    v.material_field = s.material_field.data();
     v.material       = s.material.data();
     return v;
   }
@@ -42,7 +43,8 @@ namespace mpm
   struct HostPoints
   {
     std::vector<Real> position[dim], velocity[dim], mass, volume, initial_volume, stress[n_voigt],
-      strain[n_voigt], deformation_gradient[dim * dim], domain_half_length[dim], initial_domain_half_length[dim], plastic_strain;
+      strain[n_voigt], deformation_gradient[dim * dim], domain_half_length[dim], initial_domain_half_length[dim], plastic_strain,
+      material_field;
     std::vector<int> material;
 
     int size() const { return static_cast<int>(mass.size()); }
@@ -67,6 +69,7 @@ namespace mpm
       volume.resize(n);
       initial_volume.resize(n);
       plastic_strain.resize(n);
+      material_field.resize(n);
       material.resize(n);
     }
 

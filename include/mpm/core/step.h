@@ -321,7 +321,11 @@ namespace mpm
             for (int c = 0; c < n_voigt; ++c)
               state.stress[c] = p.stress[c][i];
             state.plastic_strain = p.plastic_strain[i];
-            update_stress(materials[p.material[i]], d_eps, dW, state);
+            const MaterialParameters<Real> &material = materials[p.material[i]];
+            if (material.field_parameter == FieldParameter::none)
+              update_stress(material, d_eps, dW, state);
+            else
+              update_stress(with_field_value(material, p.material_field[i]), d_eps, dW, state);
             for (int c = 0; c < n_voigt; ++c)
               {
                 p.stress[c][i] = state.stress[c];

@@ -87,6 +87,7 @@ namespace mpm
     Real *domain_half_length[dim];         // GIMP particle half-lengths (current)
     Real *initial_domain_half_length[dim]; // at the reference configuration
     Real *plastic_strain;                  // accumulated equivalent plastic strain
+    Real *material_field;                  // per-point value of the material's random-field parameter
     int  *material;
   };
 } // namespace mpm

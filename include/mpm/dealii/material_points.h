@@ -33,7 +33,8 @@ namespace mpm
     static constexpr unsigned int plastic_strain       = initial_domain_half_length + dim;
     static constexpr unsigned int material             = plastic_strain + 1;
     static constexpr unsigned int initial_position     = material + 1;
-    static constexpr unsigned int n_properties         = initial_position + dim;
+    static constexpr unsigned int material_field       = initial_position + dim;
+    static constexpr unsigned int n_properties         = material_field + 1;
 
     static std::vector<std::string> names();
     static std::vector<dealii::DataComponentInterpretation::DataComponentInterpretation> interpretations();

@@ -6,6 +6,7 @@
 #include <mpm/core/material/material.h>
 #include <mpm/core/shape_functions.h>
 #include <mpm/core/step.h>
+#include <mpm/fields/gaussian_random_field.h>
 
 #include <deal.II/base/parameter_handler.h>
 
@@ -64,6 +65,9 @@ namespace mpm
     std::vector<std::string>                material_names;
     std::vector<std::string>                material_models;
     std::vector<MaterialParameters<double>> materials;
+    // Random field of the parameter named by materials[m].field_parameter (core units:
+    // Pa, rad), mean = the material's own value.
+    std::vector<RandomFieldParameters>      material_fields;
     std::vector<BodyParameters>             bodies;
     std::vector<unsigned int>               body_material; // index into materials
 

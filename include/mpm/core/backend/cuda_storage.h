@@ -89,7 +89,8 @@ namespace mpm
   struct DevicePoints
   {
     DeviceArray<Real> position[dim], velocity[dim], mass, volume, initial_volume, stress[n_voigt], strain[n_voigt],
-      deformation_gradient[dim * dim], domain_half_length[dim], initial_domain_half_length[dim], plastic_strain;
+      deformation_gradient[dim * dim], domain_half_length[dim], initial_domain_half_length[dim], plastic_strain,
+      material_field;
     DeviceArray<int> material;
 
     int size() const { return static_cast<int>(mass.size()); }
@@ -114,6 +115,7 @@ namespace mpm
       volume.upload(h.volume);
       initial_volume.upload(h.initial_volume);
       plastic_strain.upload(h.plastic_strain);
+      material_field.upload(h.material_field);
       material.upload(h.material);
     }
 
@@ -137,13 +139,14 @@ namespace mpm
       volume.download(h.volume);
       initial_volume.download(h.initial_volume);
       plastic_strain.download(h.plastic_strain);
+      material_field.download(h.material_field);
       material.download(h.material);
     }
 
     // Bytes of device memory held per point.
     static constexpr size_t bytes_per_point()
     {
-      return (4 * dim + 4 + 2 * n_voigt + dim * dim) * sizeof(Real) + sizeof(int);
+      return (4 * dim + 5 + 2 * n_voigt + dim * dim) * sizeof(Real) + sizeof(int);
     }
 
     PointsView<dim, Real> view() { return make_points_view<dim, Real>(*this); }

@@ -17,6 +17,16 @@ namespace mpm
     mohr_coulomb   = 2  // non-associated, principal-space return (plane, edge, apex)
   };
 
+  // A material parameter that varies from point to point (a random field sampled at the
+  // points, PointsView::material_field): the point's value replaces the material's.
+  enum class FieldParameter : int
+  {
+    none           = 0,
+    cohesion       = 1, // c_peak; c_res keeps its ratio to c_peak
+    friction_angle = 2, // phi_peak (rad); phi_res keeps its difference to phi_peak
+    youngs_modulus = 3
+  };
+
   template <typename Real>
   struct MaterialParameters
   {
@@ -28,6 +38,7 @@ namespace mpm
     // false: plastic models behave elastically (elastic-loading phase before the prm time
     // at which plasticity is switched on); eps_p is then left unchanged.
     bool plasticity_enabled = true;
+    FieldParameter field_parameter = FieldParameter::none;
   };
 
   // Per-point state a constitutive update reads and writes.
@@ -37,6 +48,35 @@ namespace mpm
     SymTensor<Real> stress;
     Real            plastic_strain;
   };
+
+  template <typename Real>
+  MPM_HOST_DEVICE inline void set_field_strength(SofteningStrength<Real> &s, const FieldParameter which,
+                                                 const Real value)
+  {
+    if (which == FieldParameter::cohesion)
+      {
+        s.residual_cohesion = s.cohesion > Real(0) ? s.residual_cohesion * (value / s.cohesion) : Real(0);
+        s.cohesion          = value;
+      }
+    else if (which == FieldParameter::friction_angle)
+      {
+        s.residual_friction_angle += value - s.friction_angle;
+        s.friction_angle = value;
+        if (s.dilatancy_angle > value)
+          s.dilatancy_angle = value;
+      }
+  }
+
+  // The material as seen by one point whose field value is `value`.
+  template <typename Real>
+  MPM_HOST_DEVICE inline MaterialParameters<Real> with_field_value(MaterialParameters<Real> m, const Real value)
+  {
+    if (m.field_parameter == FieldParameter::youngs_modulus)
+      m.elastic.youngs_modulus = value;
+    set_field_strength(m.drucker_prager.strength, m.field_parameter, value);
+    set_field_strength(m.mohr_coulomb.strength, m.field_parameter, value);
+    return m;
+  }
 
   template <typename Real>
   MPM_HOST_DEVICE inline void update_stress(const MaterialParameters<Real> &m,
