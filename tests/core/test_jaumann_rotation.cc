@@ -1,8 +1,7 @@
 // The Jaumann (Hughes-Winget) update is objective: under a pure rigid rotation
 // (zero strain increment) the stress invariants stay constant to round-off, and the
-// stress turns with the body by the Hughes-Winget angle 2 atan(w dt / 2) per step.
-// A pure rigid rotation of a whole elastic block through the MUSL step leaves its
-// mean stress and J2 unchanged to the discretisation error of the rotation field.
+// stress turns with the body by the Hughes-Winget angle 2 atan(w dt / 2) per step;
+// a strain increment alone follows Hooke's law.
 #include <mpm/core/material/material.h>
 
 #include "check.h"

@@ -59,7 +59,7 @@ namespace mpm
   };
 
   // Hooks between a P2G pass and the nodal update, where ranks sum their ghost
-  // contributions (deal.II's compress/update_ghost_values). The core needs none.
+  // contributions (deal.II's Partitioner import/export in the deal.II layer). The core needs none.
   struct NoGridExchange
   {
     template <typename Real>

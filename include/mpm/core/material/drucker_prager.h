@@ -137,13 +137,13 @@ namespace mpm
                                                                   SymTensor<Real>       &stress,
                                                                   Real                  &plastic_strain)
   {
-    linear_elastic_update(elastic, d_eps, d_spin, stress);
-    if (!plasticity_enabled)
-      return elastic_return<Real>();
-    const DruckerPragerCoefficients<Real> k =
-      drucker_prager_coefficients(current_strength(dp.strength, plastic_strain), dp.tensile_strength);
-    const ReturnResult<Real> r = drucker_prager_return(elastic, k, stress);
-    plastic_strain += r.d_plastic_strain;
-    return r;
+    return elastoplastic_update(elastic, plasticity_enabled, d_eps, d_spin, stress, plastic_strain,
+                                [&](SymTensor<Real> &trial, const Real eps_p) {
+                                  return drucker_prager_return(
+                                    elastic,
+                                    drucker_prager_coefficients(current_strength(dp.strength, eps_p),
+                                                                dp.tensile_strength),
+                                    trial);
+                                });
   }
 } // namespace mpm

@@ -204,11 +204,9 @@ namespace mpm
                                                                 SymTensor<Real>       &stress,
                                                                 Real                  &plastic_strain)
   {
-    linear_elastic_update(elastic, d_eps, d_spin, stress);
-    if (!plasticity_enabled)
-      return elastic_return<Real>();
-    const ReturnResult<Real> r = mohr_coulomb_return(elastic, current_strength(mc.strength, plastic_strain), stress);
-    plastic_strain += r.d_plastic_strain;
-    return r;
+    return elastoplastic_update(elastic, plasticity_enabled, d_eps, d_spin, stress, plastic_strain,
+                                [&](SymTensor<Real> &trial, const Real eps_p) {
+                                  return mohr_coulomb_return(elastic, current_strength(mc.strength, eps_p), trial);
+                                });
   }
 } // namespace mpm

@@ -8,6 +8,7 @@
 #pragma once
 
 #include <mpm/core/config.h>
+#include <mpm/core/material/linear_elastic.h>
 
 #include <cmath>
 
@@ -94,6 +95,26 @@ namespace mpm
     r.mode          = ReturnMode::elastic;
     r.multiplier[0] = r.multiplier[1] = Real(0);
     r.d_plastic_strain                = Real(0);
+    return r;
+  }
+
+  // The frame every plastic model shares: Jaumann rotation and elastic trial, then (unless
+  // in the elastic-loading phase) the model's return mapping with the strength at the
+  // start-of-step plastic strain (explicit softening), then eps_p += d eps_p.
+  template <typename Real, typename ReturnMapping>
+  MPM_HOST_DEVICE inline ReturnResult<Real> elastoplastic_update(const LinearElasticParameters<Real> &elastic,
+                                                                 const bool             plasticity_enabled,
+                                                                 const SymTensor<Real> &d_eps,
+                                                                 const Mat3<Real>      &d_spin,
+                                                                 SymTensor<Real>       &stress,
+                                                                 Real                  &plastic_strain,
+                                                                 ReturnMapping        &&return_mapping)
+  {
+    linear_elastic_update(elastic, d_eps, d_spin, stress);
+    if (!plasticity_enabled)
+      return elastic_return<Real>();
+    const ReturnResult<Real> r = return_mapping(stress, plastic_strain);
+    plastic_strain += r.d_plastic_strain;
     return r;
   }
 } // namespace mpm
