@@ -16,9 +16,13 @@
 //             cell (sorted by cell index, x fastest: what sorting by cell would give),
 //             random (shuffled: the worst case for the atomic scatter)
 //   --block N threads per block of the point and node loops (default 128)
+//   --material elastic|dp   linear elastic stand-in, or ep2-3De's Drucker-Prager (default dp)
+//   --sort-every N          sort the points by stencil on the device every N steps (0: never;
+//                           default 20), so that the warp adders reduce runs of shared nodes
 #include "p1_scene.h"
 
 #include <mpm/core/backend/cuda_backend.h>
+#include <mpm/core/backend/cuda_point_order.h>
 #include <mpm/core/backend/cuda_storage.h>
 #include <mpm/core/step.h>
 
@@ -45,6 +49,8 @@ namespace
     std::string      table;
     std::string      order = "generated";
     int              block = 128;
+    bool             drucker_prager = true;
+    int              sort_every     = 20;
   };
 
   // Reorder every point array by perm (new point i is old point perm[i]).
@@ -145,9 +151,10 @@ namespace
     return n_points * (69.0 * sizeof(Real) + sizeof(int)) + n_nodes * (20.0 * sizeof(Real) + 5.0);
   }
 
-  const char *musl_launch_names[] = {"reset grid",        "P2G mass+momentum+forces", "grid update",
-                                     "G2P velocity",      "reset momentum",           "remap P2G momentum",
-                                     "nodal velocity",    "G2P kinematics+stress",    "reduction (dt)"};
+  const char *musl_launch_names[] = {"reset grid",     "P2G mass+momentum+forces", "grid update",
+                                     "reset momentum", "G2P velocity + remap P2G", "nodal velocity",
+                                     "G2P kinematics+stress", "reduction (dt)"};
+  constexpr int n_musl_launches = 8;
 
   template <typename Real>
   bool run_size(const int n_cells_y, const Options &opt, const double bandwidth, FILE *table)
@@ -172,7 +179,7 @@ namespace
     HostGrid<3, Real>   grid;
     HostPoints<3, Real> points;
     std::vector<MaterialParameters<Real>> materials;
-    mpm_bench::make_p1(n_cells_y, grid, points, materials);
+    mpm_bench::make_p1(n_cells_y, grid, points, materials, opt.drucker_prager);
     reorder(points, grid, opt.order);
     const int  n_points = points.size();
     const long n_cells  = long(grid.n_cells[0]) * grid.n_cells[1] * grid.n_cells[2];
@@ -188,8 +195,17 @@ namespace
 
     CudaBackend backend;
     backend.block_size = opt.block;
+    PointOrder<3, Real> order;
     auto        gv = dgrid.view();
     auto        pv = dpoints.view();
+    // Sorting swaps the point arrays: the view is taken again after each sort.
+    auto sort_if_due = [&](const long step) {
+      if (opt.sort_every > 0 && step % opt.sort_every == 0)
+        {
+          order.template sort<GimpShape>(backend, gv, dpoints);
+          pv = dpoints.view();
+        }
+    };
     StepSettings<3, Real> s = mpm_bench::p1_settings<Real>();
     const double          c = mpm_bench::p1_wave_speed();
 
@@ -198,6 +214,7 @@ namespace
       double max_speed = 0, t = 0;
       for (int i = 0; i < 3; ++i)
         {
+          sort_if_due(i);
           const double dt = P1::cfl * P1::h / (c + max_speed);
           mpm_bench::p1_gravity(s, t);
           max_speed = explicit_step<3, GimpShape>(backend, gv, pv, dmaterials.data(), s, Real(dt)).max_speed;
@@ -205,6 +222,8 @@ namespace
         }
       dgrid.upload(grid);
       dpoints.upload(points);
+      pv = dpoints.view();
+      order.reset(backend, n_points);
       backend.synchronize();
     }
 
@@ -217,6 +236,7 @@ namespace
     MPM_CUDA_CHECK(cudaEventRecord(start, backend.get_stream()));
     while (t < P1::t_end - 1e-9 && (opt.steps < 0 || steps < opt.steps))
       {
+        sort_if_due(steps);
         const double dt = P1::cfl * P1::h / (c + max_speed);
         mpm_bench::p1_gravity(s, t);
         max_speed = explicit_step<3, GimpShape>(backend, gv, pv, dmaterials.data(), s, Real(dt)).max_speed;
@@ -256,6 +276,8 @@ namespace
       label += ", " + opt.order + " order";
     if (opt.block != 128)
       label += ", block " + std::to_string(opt.block);
+    label += opt.drucker_prager ? ", DP" : ", elastic";
+    label += opt.sort_every > 0 ? ", sorted every " + std::to_string(opt.sort_every) : ", unsorted";
     const double updates  = double(n_points) * steps / wall;
     const double bytes    = minimal_bytes_per_step<Real>(n_points, n_nodes);
     const double fraction = bytes * steps / wall / bandwidth;
@@ -280,7 +302,7 @@ namespace
       {
         backend.enable_kernel_timing(true);
         const int          n_prof = 5;
-        std::vector<double> sum(9, 0.0);
+        std::vector<double> sum(n_musl_launches, 0.0);
         for (int i = 0; i < n_prof; ++i)
           {
             const double dt = P1::cfl * P1::h / (c + max_speed);
@@ -326,6 +348,18 @@ int main(int argc, char **argv)
         opt.steps = std::atol(argv[++i]);
       else if (a == "--order" && i + 1 < argc)
         opt.order = argv[++i];
+      else if (a == "--material" && i + 1 < argc)
+        {
+          const std::string m = argv[++i];
+          if (m != "dp" && m != "elastic")
+            {
+              std::printf("--material: expected dp or elastic, got %s\n", m.c_str());
+              return 2;
+            }
+          opt.drucker_prager = m == "dp";
+        }
+      else if (a == "--sort-every" && i + 1 < argc)
+        opt.sort_every = std::atoi(argv[++i]);
       else if (a == "--block" && i + 1 < argc)
         opt.block = std::atoi(argv[++i]);
       else if (a == "--table" && i + 1 < argc)
@@ -345,7 +379,7 @@ int main(int argc, char **argv)
       else
         {
           std::printf("usage: %s [--fp32] [--sizes 20,160,640,2560] [--steps N] [--profile] [--table FILE]\n"
-                      "          [--order generated|cell|random] [--block N]\n",
+                      "          [--order generated|cell|random] [--block N] [--material dp|elastic] [--sort-every N]\n",
                       argv[0]);
           return 2;
         }
@@ -367,9 +401,10 @@ int main(int argc, char **argv)
                   prop.name, prop.multiProcessorCount, total_bytes / 1e9, free_bytes / 1e9, prop.l2CacheSize / 1e6,
                   bandwidth / 1e9);
       const double per_point = opt.fp32 ? DevicePoints<3, float>::bytes_per_point() : DevicePoints<3, double>::bytes_per_point();
-      std::printf("scene P1 (elastic phase, linear elastic stand-in for Drucker-Prager), %s, point order %s, %d "
-                  "threads per block; device memory per point %.0f B: about %.0f M points would fit\n",
-                  opt.fp32 ? "FP32" : "FP64", opt.order.c_str(), opt.block, per_point,
+      std::printf("scene P1 (elastic phase, %s), %s, point order %s, sorted every %d steps, %d threads per block; "
+                  "device memory per point %.0f B: about %.0f M points would fit\n",
+                  opt.drucker_prager ? "Drucker-Prager" : "linear elastic stand-in for Drucker-Prager",
+                  opt.fp32 ? "FP32" : "FP64", opt.order.c_str(), opt.sort_every, opt.block, per_point,
                   0.9 * free_bytes / (per_point * 1.1) / 1e6);
       std::printf("| prec | points | cells | nodes | steps | wall s | point-updates/s | ms/step | min bytes/step | "
                   "fraction of copy BW | MTP_eff GB/s | host wall s | setup s | removed | non-finite | "

@@ -8,9 +8,11 @@
 // The grid reaches 2 cells past the walls (x = 0 and 64.1584, y = 0 and L_y) and the
 // base (z = 0), and 20 cells up from z = -2h; free-slip: the normal velocity component is
 // prescribed zero on the nodes on or beyond each wall and the base.
-// Material: rho = 2700, E = 1 MPa, nu = 0.3, linear elastic (Jaumann) for now: the
-// Drucker-Prager model is being written in parallel, and P1's timed phase is its elastic
-// loading. Gravity ramped linearly over 8/1.5 s, local damping 0.1, CFL 0.5, 8 s.
+// Material: rho = 2700, E = 1 MPa, nu = 0.3; either linear elastic (Jaumann) or, as
+// ep2-3De runs it, Drucker-Prager with plasticity on from the start: c = 20 kPa (c_res =
+// 4 kPa, softening modulus 60 kPa x h), phi = 20 deg (7 deg in the weak layer z < 3.84 m,
+// material 1), psi = 0, tension cut-off at the apex. Gravity ramped linearly over 8/1.5 s,
+// local damping 0.1, CFL 0.5, 8 s.
 #pragma once
 
 #include <mpm/core/host_storage.h>
@@ -38,6 +40,7 @@ namespace mpm_bench
     static constexpr double damping  = 0.1;
     static constexpr double cfl      = 0.5;
     static constexpr int    ghost    = 2;  // cells of grid beyond each wall
+    static constexpr double weak_layer = 3.84; // Drucker-Prager: phi = 7 deg below this z
     static constexpr int    cells_z  = 20; // from z = -2h
   };
 
@@ -70,7 +73,7 @@ namespace mpm_bench
   // 100,240 / 801,920 / 3,207,680 / 12,830,720 points.
   template <typename Real>
   void make_p1(const int n_cells_y, mpm::HostGrid<3, Real> &grid, mpm::HostPoints<3, Real> &points,
-               std::vector<mpm::MaterialParameters<Real>> &materials)
+               std::vector<mpm::MaterialParameters<Real>> &materials, const bool drucker_prager = false)
   {
     using namespace mpm;
     const double h        = P1::h;
@@ -117,7 +120,7 @@ namespace mpm_bench
           points.volume[i] = points.initial_volume[i] = V;
           points.mass[i]                              = Real(P1::rho) * V;
           points.plastic_strain[i]                    = Real(0);
-          points.material[i]                          = 0;
+          points.material[i]                          = drucker_prager && x[2] < P1::weak_layer ? 1 : 0;
         }
 
     MaterialParameters<Real> m;
@@ -125,6 +128,20 @@ namespace mpm_bench
     m.elastic.youngs_modulus = Real(P1::youngs);
     m.elastic.poissons_ratio = Real(P1::poisson);
     materials.assign(1, m);
+    if (drucker_prager)
+      {
+        const double degree = 3.14159265358979323846 / 180;
+        SofteningStrength<Real> &st = m.drucker_prager.strength;
+        m.model                     = MaterialModel::drucker_prager;
+        st.cohesion                 = Real(20e3);
+        st.residual_cohesion        = Real(4e3);
+        st.softening_modulus        = Real(60e3 * h);
+        st.friction_angle = st.residual_friction_angle = Real(20 * degree);
+        st.dilatancy_angle                             = Real(0);
+        materials.assign(2, m);
+        materials[1].drucker_prager.strength.friction_angle          = Real(7 * degree);
+        materials[1].drucker_prager.strength.residual_friction_angle = Real(7 * degree);
+      }
   }
 
   template <typename Real>

@@ -80,12 +80,12 @@ namespace mpm_test
     {
       Target<2, double> target(grid, points, {material});
       auto              gv        = target.grid();
-      auto              pv        = target.points();
       double            max_speed = 0;
       while (r.time < t_end - 1e-12 * t_end && (setup.max_steps < 0 || r.n_steps < setup.max_steps))
         {
           const double dt = std::min(setup.cfl * h / (c + max_speed), t_end - r.time);
           s.gravity[1]    = -g * std::min(1.0, r.time / t_ramp);
+          const auto pv   = target.template points_at_step<Shape>(r.n_steps);
           max_speed = explicit_step<2, Shape>(target.backend, gv, pv, target.material_table(), s, dt).max_speed;
           r.time += dt;
           ++r.n_steps;

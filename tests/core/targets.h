@@ -29,6 +29,12 @@ namespace mpm_test
     {}
     mpm::GridView<dim, Real>             grid() { return host_grid.view(); }
     mpm::PointsView<dim, Real>           points() { return host_points.view(); }
+    // The points for step `step` (a GPU target may reorder them between steps).
+    template <typename Shape>
+    mpm::PointsView<dim, Real> points_at_step(const long /*step*/)
+    {
+      return points();
+    }
     const mpm::MaterialParameters<Real> *material_table() const { return materials.data(); }
     void                                 finish() {}
   };

@@ -2,10 +2,9 @@
 // CPU and GPU runs of one scene execute the same host code around the same step.h.
 //   column  : tests/core/elastic_column.h (V1, shared with the CPU tests)
 //   slump   : P1/V5 slump geometry, reduced to 2 cells across (3D, GIMP, 10,024 points),
-//             elastic, gravity ramp, local damping 0.1, free-slip walls and base
+//             elastic or Drucker-Prager, gravity ramp, local damping 0.1, free-slip walls and base
 //   collapse: V3 geometry (2D, 0.2 m x 0.1 m column against a wall), h = 5 mm, 2x2 ppc,
-//             elastic until the Drucker-Prager model lands; no-slip base, rollers on walls,
-//             gravity applied at once
+//             elastic or Drucker-Prager; no-slip base, rollers on walls, gravity applied at once
 #pragma once
 
 #include "../../benchmarks/p1_scene.h"
@@ -29,13 +28,14 @@ namespace mpm_test
   // P1 slump geometry, n_cells_y cells across, elastic phase, fixed number of steps.
   template <template <int, typename> class Target, typename Real = double>
   SceneResult slump(const int n_cells_y, mpm::HostPoints<3, Real> &points, const long n_steps,
-                    const mpm::HostPoints<3, Real> *initial = nullptr, const double damping = mpm_bench::P1::damping)
+                    const mpm::HostPoints<3, Real> *initial = nullptr, const double damping = mpm_bench::P1::damping,
+                    const bool drucker_prager = false)
   {
     using namespace mpm;
     using mpm_bench::P1;
     HostGrid<3, Real>                     grid;
     std::vector<MaterialParameters<Real>> materials;
-    mpm_bench::make_p1(n_cells_y, grid, points, materials);
+    mpm_bench::make_p1(n_cells_y, grid, points, materials, drucker_prager);
     if (initial != nullptr)
       points = *initial; // same scene, points given (e.g. reordered)
     StepSettings<3, Real> s = mpm_bench::p1_settings<Real>();
@@ -43,13 +43,13 @@ namespace mpm_test
     const double          c = mpm_bench::p1_wave_speed();
     Target<3, Real>       target(grid, points, materials);
     auto                  gv = target.grid();
-    auto                  pv = target.points();
     SceneResult           r;
     double                max_speed = 0;
     for (; r.n_steps < n_steps; ++r.n_steps)
       {
         const double dt = P1::cfl * P1::h / (c + max_speed);
         mpm_bench::p1_gravity(s, r.time);
+        const auto pv = target.template points_at_step<GimpShape>(r.n_steps);
         max_speed = explicit_step<3, GimpShape>(target.backend, gv, pv, target.material_table(), s, Real(dt)).max_speed;
         r.time += dt;
       }
@@ -57,10 +57,11 @@ namespace mpm_test
     return r;
   }
 
-  // V3 geometry (2D), elastic, gravity at once.
+  // V3 geometry (2D), gravity at once; elastic, or V3's Drucker-Prager (c = 0,
+  // phi = 19.8 deg, psi = 0: the column starts to fail within the first steps).
   template <template <int, typename> class Target>
   SceneResult collapse(mpm::HostPoints<2, double> &points, const long n_steps,
-                       const mpm::HostPoints<2, double> *initial = nullptr)
+                       const mpm::HostPoints<2, double> *initial = nullptr, const bool drucker_prager = false)
   {
     using namespace mpm;
     const double h = 0.005, rho = 2650, E = 0.84e6, nu = 0.3, g = 9.81, cfl = 0.5;
@@ -90,6 +91,12 @@ namespace mpm_test
     m.model                  = MaterialModel::linear_elastic;
     m.elastic.youngs_modulus = E;
     m.elastic.poissons_ratio = nu;
+    if (drucker_prager)
+      {
+        m.model                                   = MaterialModel::drucker_prager;
+        m.drucker_prager.strength.friction_angle  = 19.8 * 3.14159265358979323846 / 180;
+        m.drucker_prager.strength.residual_friction_angle = m.drucker_prager.strength.friction_angle;
+      }
     const double c = std::sqrt(m.elastic.p_wave_modulus() / rho);
 
     StepSettings<2, double> s;
@@ -102,12 +109,12 @@ namespace mpm_test
     s.mass_tolerance = 1e-12 * points.mass[0];
     Target<2, double> target(grid, points, {m});
     auto              gv = target.grid();
-    auto              pv = target.points();
     SceneResult       r;
     double            max_speed = 0;
     for (; r.n_steps < n_steps; ++r.n_steps)
       {
         const double dt = cfl * h / (c + max_speed);
+        const auto pv = target.template points_at_step<GimpShape>(r.n_steps);
         max_speed = explicit_step<2, GimpShape>(target.backend, gv, pv, target.material_table(), s, dt).max_speed;
         r.time += dt;
       }

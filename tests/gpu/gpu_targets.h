@@ -5,6 +5,7 @@
 #include "../core/targets.h"
 
 #include <mpm/core/backend/cuda_backend.h>
+#include <mpm/core/backend/cuda_point_order.h>
 #include <mpm/core/backend/cuda_storage.h>
 #include <mpm/core/host_storage.h>
 #include <mpm/core/step.h>
@@ -46,6 +47,9 @@ namespace mpm_test
     mpm::DeviceMaterials<Real>    device_materials;
     mpm::CudaBackend              backend;
 
+    mpm::PointOrder<dim, Real>    order;
+    int                           sort_every = 0; // sort the points by stencil every n steps (0: never)
+
     CudaTarget(mpm::HostGrid<dim, Real> &g, mpm::HostPoints<dim, Real> &p,
                const std::vector<mpm::MaterialParameters<Real>> &m)
       : host_grid(g)
@@ -54,15 +58,42 @@ namespace mpm_test
       device_grid.upload(g);
       device_points.upload(p);
       device_materials.upload(m);
+      order.reset(backend, device_points.size());
     }
     mpm::GridView<dim, Real>             grid() { return device_grid.view(); }
     mpm::PointsView<dim, Real>           points() { return device_points.view(); }
+    template <typename Shape>
+    mpm::PointsView<dim, Real> points_at_step(const long step)
+    {
+      if (sort_every > 0 && step % sort_every == 0)
+        order.template sort<Shape>(backend, device_grid.view(), device_points);
+      return points();
+    }
     const mpm::MaterialParameters<Real> *material_table() const { return device_materials.data(); }
-    void                                 finish()
+    // Points back to the host in the order they were uploaded.
+    void finish()
     {
       backend.synchronize();
-      device_points.download(host_points);
+      mpm::HostPoints<dim, Real> slots;
+      std::vector<int>           original;
+      device_points.download(slots);
+      order.original_index().download(original);
+      mpm::PointOrder<dim, Real>::restore_reference_order(original, slots, host_points);
       device_grid.download_nodal(host_grid);
+    }
+  };
+
+  // The same, with the points sorted by stencil every 7 steps (add_to_node then
+  // reduce runs of shared nodes; results must not change beyond rounding).
+  template <int dim, typename Real>
+  struct CudaSortedTarget : CudaTarget<dim, Real>
+  {
+    static constexpr const char *name = "cuda, sorted";
+    CudaSortedTarget(mpm::HostGrid<dim, Real> &g, mpm::HostPoints<dim, Real> &p,
+                     const std::vector<mpm::MaterialParameters<Real>> &m)
+      : CudaTarget<dim, Real>(g, p, m)
+    {
+      this->sort_every = 7;
     }
   };
 

@@ -26,6 +26,9 @@
 // points changes velocities by 8e-9 of max |v| (4e-14 with D = 0). So the scenes run
 // without damping are held to 1e-10, and the damped ones (column D = 0.05, slump D = 0.1)
 // to max(1e-10, 100 x the CPU's own reordering spread).
+// Drucker-Prager scenes are held like the damped ones: the choice between the elastic,
+// shear, tension and corner returns switches on inequalities, so a point at a switch
+// follows the order of the sums.
 // Only GIMP is compared: its weights are C1 in the point position, so a perturbation of a
 // position changes the weights by as much; standard MPM's gradients jump at cell faces.
 #include "../core/check.h"
@@ -50,6 +53,16 @@ void report(const char *scene, const Difference &gpu, const Difference &reordere
   check(gpu.removed_mismatch == 0, (std::string(scene) + ": same points removed").c_str());
 }
 
+// Fraction of the points with accumulated plastic strain.
+template <int dim>
+double plastic_fraction(const HostPoints<dim, double> &p)
+{
+  int yielded = 0;
+  for (int i = 0; i < p.size(); ++i)
+    yielded += p.plastic_strain[i] > 0;
+  return double(yielded) / p.size();
+}
+
 int main()
 {
   if (!cuda_device_present("test_gpu_cpu_agreement"))
@@ -70,6 +83,9 @@ int main()
         elastic_column<GimpShape, CudaTarget>(setup, gpu, &initial);
         report<2>("V1 column 32 cells (2D GIMP)", compare_points(cpu, gpu, 10.0 / 32),
                   compare_points(cpu, reversed(rev), 10.0 / 32), n, true);
+        elastic_column<GimpShape, CudaSortedTarget>(setup, gpu, &initial);
+        report<2>("V1 column, GPU sorted every 7", compare_points(cpu, gpu, 10.0 / 32),
+                  compare_points(cpu, reversed(rev), 10.0 / 32), n, true);
       }
       {
         // V3 geometry, elastic, 600 steps of gravity applied at once
@@ -82,6 +98,41 @@ int main()
         collapse<CudaTarget>(gpu, n, &initial);
         report<2>("V3 collapse geometry, elastic (2D)", compare_points(cpu, gpu, 0.005),
                   compare_points(cpu, reversed(rev), 0.005), n, false);
+        collapse<CudaSortedTarget>(gpu, n, &initial);
+        report<2>("V3 collapse, GPU sorted every 7", compare_points(cpu, gpu, 0.005),
+                  compare_points(cpu, reversed(rev), 0.005), n, false);
+      }
+      {
+        // V3 with Drucker-Prager (c = 0, phi = 19.8 deg): the column yields from the start
+        const long            n = 600;
+        HostPoints<2, double> cpu, rev, gpu, initial;
+        collapse<CpuTarget>(initial, 0, nullptr, true);
+        collapse<CpuTarget>(cpu, n, &initial, true);
+        const HostPoints<2, double> initial_rev = reversed(initial);
+        collapse<CpuTarget>(rev, n, &initial_rev, true);
+        const double yielded = plastic_fraction(cpu);
+        std::printf("V3 Drucker-Prager: %.1f%% of the points have yielded after %ld steps\n", 100 * yielded, n);
+        check(yielded > 0.01, "V3 Drucker-Prager: the scene exercises the plastic return");
+        collapse<CudaTarget>(gpu, n, &initial, true);
+        report<2>("V3 collapse, Drucker-Prager (2D)", compare_points(cpu, gpu, 0.005),
+                  compare_points(cpu, reversed(rev), 0.005), n, true);
+        collapse<CudaSortedTarget>(gpu, n, &initial, true);
+        report<2>("V3 collapse, DP, GPU sorted every 7", compare_points(cpu, gpu, 0.005),
+                  compare_points(cpu, reversed(rev), 0.005), n, true);
+      }
+      {
+        // P1 with ep2-3De's Drucker-Prager and softening, 2 cells across, 200 steps
+        const long            n = 200;
+        HostPoints<3, double> cpu, rev, gpu, initial;
+        slump<CpuTarget>(2, initial, 0, static_cast<const HostPoints<3, double> *>(nullptr), mpm_bench::P1::damping, true);
+        slump<CpuTarget>(2, cpu, n, &initial, mpm_bench::P1::damping, true);
+        const HostPoints<3, double> initial_rev = reversed(initial);
+        slump<CpuTarget>(2, rev, n, &initial_rev, mpm_bench::P1::damping, true);
+        std::printf("P1 Drucker-Prager: %.1f%% of the points have yielded after %ld steps\n",
+                    100 * plastic_fraction(cpu), n);
+        slump<CudaSortedTarget>(2, gpu, n, &initial, mpm_bench::P1::damping, true);
+        report<3>("P1/V5 slump, DP, GPU sorted every 7, D=0.1", compare_points(cpu, gpu, mpm_bench::P1::h),
+                  compare_points(cpu, reversed(rev), mpm_bench::P1::h), n, true);
       }
       for (const double damping : {0.0, mpm_bench::P1::damping})
         {
@@ -94,6 +145,10 @@ int main()
           slump<CpuTarget>(2, rev, n, &initial_rev, damping);
           slump<CudaTarget>(2, gpu, n, &initial, damping);
           report<3>(damping > 0 ? "P1/V5 slump 2 cells across, D=0.1" : "P1/V5 slump 2 cells across, D=0",
+                    compare_points(cpu, gpu, mpm_bench::P1::h), compare_points(cpu, reversed(rev), mpm_bench::P1::h),
+                    n, damping > 0);
+          slump<CudaSortedTarget>(2, gpu, n, &initial, damping);
+          report<3>(damping > 0 ? "P1/V5 slump, GPU sorted every 7, D=0.1" : "P1/V5 slump, GPU sorted every 7, D=0",
                     compare_points(cpu, gpu, mpm_bench::P1::h), compare_points(cpu, reversed(rev), mpm_bench::P1::h),
                     n, damping > 0);
         }

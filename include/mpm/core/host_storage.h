@@ -39,6 +39,33 @@ namespace mpm
     return v;
   }
 
+  // Visits the matching arrays of two owners of point arrays (HostPoints, DevicePoints,
+  // or one owner twice) as f(array of a, array of b): upload, download, permutation.
+  template <int dim, typename A, typename B, typename F>
+  void for_each_point_array(A &a, B &b, F &&f)
+  {
+    for (int d = 0; d < dim; ++d)
+      {
+        f(a.position[d], b.position[d]);
+        f(a.velocity[d], b.velocity[d]);
+        f(a.domain_half_length[d], b.domain_half_length[d]);
+        f(a.initial_domain_half_length[d], b.initial_domain_half_length[d]);
+      }
+    for (int c = 0; c < n_voigt; ++c)
+      {
+        f(a.stress[c], b.stress[c]);
+        f(a.strain[c], b.strain[c]);
+      }
+    for (int c = 0; c < dim * dim; ++c)
+      f(a.deformation_gradient[c], b.deformation_gradient[c]);
+    f(a.mass, b.mass);
+    f(a.volume, b.volume);
+    f(a.initial_volume, b.initial_volume);
+    f(a.plastic_strain, b.plastic_strain);
+    f(a.material_field, b.material_field);
+    f(a.material, b.material);
+  }
+
   template <int dim, typename Real>
   struct HostPoints
   {

@@ -1,20 +1,26 @@
 // Evaluate a point's stencil once and visit each of its nodes with the weight N_i(x_p)
 // and gradient grad N_i(x_p). Every P2G and G2P stage goes through this helper.
+//
+// Two forms of the stencil loop, the same nodes in the same order:
+// - the default: one rolled loop over the stencil positions, with run-time indices into
+//   the 1D weights and the lattice bounds checked per node;
+// - -DMPM_UNROLL_STENCIL: loops nested per direction with compile-time bounds, unrolled
+//   on the device, so that the weights stay in registers and every index into them is a
+//   constant, the products of the outer directions' weights formed once per row, and,
+//   where the whole stencil lies inside the lattice, the node's lattice index the point's
+//   base index plus a constant offset (bounds checked once per point).
+// On P1 (H100) the unrolled form raised the P2G kernel from 76 to 121 registers and made
+// it slower (doc/performance.md), so it is not the default.
 #pragma once
 
 #include <mpm/core/views.h>
 
 #include <cmath>
 
-// -DMPM_UNROLL_STENCIL unrolls the stencil loop on the device, so that w[d][k] and
-// dw[d][k] are indexed by compile-time constants and stay in registers (no stack frame
-// in P2G, remap and G2P velocity). Off by default: on P1 at 12.8M points (H100) it made
-// G2P kinematics 7% faster but the atomic scatters 5-8% slower, 3% slower in all
-// (doc/performance.md, "CUDA backend in dealii-mpm"). The host compiler decides itself.
-#if defined(__CUDA_ARCH__) && defined(MPM_UNROLL_STENCIL)
-#  define MPM_STENCIL_LOOP_PRAGMA _Pragma("unroll")
+#if defined(__CUDA_ARCH__)
+#  define MPM_UNROLL _Pragma("unroll")
 #else
-#  define MPM_STENCIL_LOOP_PRAGMA
+#  define MPM_UNROLL
 #endif
 
 namespace mpm
@@ -32,8 +38,8 @@ namespace mpm
     for (int d = 0; d < dim; ++d)
       Shape::weights_1d((x[d] - grid.origin[d]) * inv_h, half_length[d] * inv_h, first[d], w[d], dw[d]);
 
+#if !defined(MPM_UNROLL_STENCIL)
     constexpr int n_stencil = dim == 2 ? n * n : n * n * n;
-    MPM_STENCIL_LOOP_PRAGMA
     for (int s = 0; s < n_stencil; ++s)
       {
         int k[3] = {s % n, (s / n) % n, s / (n * n)};
@@ -43,7 +49,6 @@ namespace mpm
         const int node = grid.node(idx);
         if (node < 0)
           continue; // outside the lattice: the weight is zero for points inside the grid
-
         Real N = Real(1);
         for (int d = 0; d < dim; ++d)
           N *= w[d][k[d]];
@@ -58,5 +63,72 @@ namespace mpm
           }
         visit(node, N, grad);
       }
+#else
+    // Lattice strides (x fastest, as GridView::node) and the point's base index.
+    long stride[dim], base = 0;
+    bool inside = true;
+    for (int d = 0; d < dim; ++d)
+      {
+        stride[d] = d == 0 ? 1 : stride[d - 1] * (grid.n_cells[d - 1] + 1);
+        base += first[d] * stride[d];
+        inside = inside && first[d] >= 0 && first[d] + n - 1 <= grid.n_cells[d];
+      }
+    // Node of stencil position k: by offset inside the lattice, else checked per node
+    // (-1 outside the lattice, where the weight is zero for points inside the grid).
+    auto node_at = [&](const int k[dim]) {
+      if (inside)
+        {
+          long offset = 0;
+          for (int d = 0; d < dim; ++d)
+            offset += k[d] * stride[d];
+          return grid.lattice_to_node[base + offset];
+        }
+      int idx[dim];
+      for (int d = 0; d < dim; ++d)
+        idx[d] = first[d] + k[d];
+      return grid.node(idx);
+    };
+    for (int d = 0; d < dim; ++d)
+      for (int k = 0; k < n; ++k)
+        dw[d][k] *= inv_h;
+
+    if constexpr (dim == 3)
+      {
+        MPM_UNROLL
+        for (int kz = 0; kz < n; ++kz)
+          MPM_UNROLL
+          for (int ky = 0; ky < n; ++ky)
+            {
+              const Real w_yz = w[1][ky] * w[2][kz], dw_y = dw[1][ky] * w[2][kz], dw_z = w[1][ky] * dw[2][kz];
+              MPM_UNROLL
+              for (int kx = 0; kx < n; ++kx)
+                {
+                  const int k[3]  = {kx, ky, kz};
+                  const int node = node_at(k);
+                  if (node < 0)
+                    continue;
+                  const Real grad[3] = {dw[0][kx] * w_yz, w[0][kx] * dw_y, w[0][kx] * dw_z};
+                  visit(node, w[0][kx] * w_yz, grad);
+                }
+            }
+      }
+    else
+      {
+        MPM_UNROLL
+        for (int ky = 0; ky < n; ++ky)
+          MPM_UNROLL
+          for (int kx = 0; kx < n; ++kx)
+            {
+              const int k[2]  = {kx, ky};
+              const int node = node_at(k);
+              if (node < 0)
+                continue;
+              const Real grad[2] = {dw[0][kx] * w[1][ky], w[0][kx] * dw[1][ky]};
+              visit(node, w[0][kx] * w[1][ky], grad);
+            }
+      }
+#endif
   }
 } // namespace mpm
+
+#undef MPM_UNROLL

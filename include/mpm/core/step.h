@@ -1,9 +1,10 @@
 // One explicit MPM step with lumped mass, written once for every backend.
 //
 // A Backend says how loops run (see backend/cpu_backend.h): for_each_node,
-// gather_points (a point writes only its own data), scatter_points (points add
-// into nodes through Backend::add), reduce_points. The stages below are what MUSL,
-// USL and USF are made of; musl_step() etc. read as the algorithm (doc/theory.md).
+// gather_points (a point writes only its own data), scatter_points (points add into
+// nodes through Backend::add_to_node, once per node or cell), reduce_points. The
+// stages below are what MUSL, USL and USF are made of; explicit_step() reads as the
+// algorithm (doc/theory.md).
 #pragma once
 
 #include <mpm/core/interpolation.h>
@@ -144,21 +145,32 @@ namespace mpm
         for (int c = 0; c < n_voigt; ++c)
           sigma[c] = p.stress[c][i];
 
+        // Nodal arrays in the order of the values below: mass, momentum, force.
+        constexpr int K = 2 * dim + 1;
+        Real         *targets[K];
+        targets[0] = g.mass;
+        for (int d = 0; d < dim; ++d)
+          {
+            targets[1 + d]       = g.momentum[d];
+            targets[1 + dim + d] = g.force[d];
+          }
         for_each_stencil_node<dim, Shape>(g, x, lp, [&](const int n, const Real N, const Real *grad) {
-          if (mass_and_momentum)
+          Real values[K];
+          values[0] = N * m;
+          for (int d = 0; d < dim; ++d)
             {
-              Backend::add(&g.mass[n], N * m);
-              for (int d = 0; d < dim; ++d)
-                Backend::add(&g.momentum[d][n], N * m * v[d]);
+              values[1 + d] = N * m * v[d];
+              Real f_int    = Real(0);
+              for (int e = 0; e < dim; ++e)
+                f_int -= sigma(d, e) * grad[e];
+              values[1 + dim + d] = V * f_int + N * m * s.gravity[d];
             }
-          if (forces)
-            for (int d = 0; d < dim; ++d)
-              {
-                Real f_int = Real(0);
-                for (int e = 0; e < dim; ++e)
-                  f_int -= sigma(d, e) * grad[e];
-                Backend::add(&g.force[d][n], V * f_int + N * m * s.gravity[d]);
-              }
+          if (mass_and_momentum && forces)
+            Backend::template add_to_node<K>(targets, n, values);
+          else if (mass_and_momentum)
+            Backend::template add_to_node<dim + 1>(targets, n, values);
+          else if (forces)
+            Backend::template add_to_node<dim>(targets + dim + 1, n, values + dim + 1);
         });
       });
     }
@@ -205,7 +217,28 @@ namespace mpm
       });
     }
 
-    // G2P velocity: FLIP v_p += dt sum N a_i, blended with PIC v_p = sum N v_i^{n+1}.
+    // G2P velocity of point i: FLIP v_p + dt sum N a_i, blended with PIC sum N v_i^{n+1}.
+    template <int dim, typename Shape, typename Real>
+    MPM_HOST_DEVICE inline void updated_point_velocity(const GridView<dim, Real> &g, const PointsView<dim, Real> &p,
+                                                       const StepSettings<dim, Real> &s, const Real dt, const int i,
+                                                       const Real x[dim], const Real lp[dim], Real v_new[dim])
+    {
+      Real a[dim] = {}, v_pic[dim] = {};
+      for_each_stencil_node<dim, Shape>(g, x, lp, [&](const int n, const Real N, const Real *) {
+        for (int d = 0; d < dim; ++d)
+          {
+            a[d] += N * g.force[d][n];
+            v_pic[d] += N * g.velocity[d][n];
+          }
+      });
+      for (int d = 0; d < dim; ++d)
+        {
+          const Real v_flip = p.velocity[d][i] + dt * a[d];
+          v_new[d]          = s.flip_fraction * v_flip + (Real(1) - s.flip_fraction) * v_pic[d];
+        }
+    }
+
+    // G2P velocity (USL, USF).
     template <int dim, typename Shape, typename Real, typename Backend>
     void grid_to_particle_velocity(Backend &backend, const GridView<dim, Real> &g,
                                    const PointsView<dim, Real> &p, const StepSettings<dim, Real> &s,
@@ -214,30 +247,26 @@ namespace mpm
       backend.gather_points(p.n_points, [=] MPM_HOST_DEVICE(const int i) {
         if (p.material[i] < 0)
           return;
-        Real x[dim], lp[dim], a[dim] = {}, v_pic[dim] = {};
+        Real x[dim], lp[dim], v_new[dim];
         for (int d = 0; d < dim; ++d)
           {
             x[d]  = p.position[d][i];
             lp[d] = p.domain_half_length[d][i];
           }
-        for_each_stencil_node<dim, Shape>(g, x, lp, [&](const int n, const Real N, const Real *) {
-          for (int d = 0; d < dim; ++d)
-            {
-              a[d] += N * g.force[d][n];
-              v_pic[d] += N * g.velocity[d][n];
-            }
-        });
+        updated_point_velocity<dim, Shape>(g, p, s, dt, i, x, lp, v_new);
         for (int d = 0; d < dim; ++d)
-          {
-            const Real v_flip = p.velocity[d][i] + dt * a[d];
-            p.velocity[d][i]  = s.flip_fraction * v_flip + (Real(1) - s.flip_fraction) * v_pic[d];
-          }
+          p.velocity[d][i] = v_new[d];
       });
     }
 
-    // MUSL remap: nodal momentum rebuilt from the updated point velocities.
+    // MUSL: G2P velocity, then the remap of the nodal momentum from the updated point
+    // velocities, sum N m_p v_p, rebuilt from zero. Fused into one pass over the points,
+    // which reads each point once for both (the remap reads only what the gather wrote
+    // and the grid's velocity and acceleration, which it does not write).
     template <int dim, typename Shape, typename Real, typename Backend>
-    void remap_momentum(Backend &backend, const GridView<dim, Real> &g, const PointsView<dim, Real> &p)
+    void grid_to_particle_velocity_and_remap(Backend &backend, const GridView<dim, Real> &g,
+                                             const PointsView<dim, Real> &p, const StepSettings<dim, Real> &s,
+                                             const Real dt)
     {
       backend.for_each_node(g.n_nodes, [=] MPM_HOST_DEVICE(const int n) {
         for (int d = 0; d < dim; ++d)
@@ -246,16 +275,27 @@ namespace mpm
       backend.scatter_points(p.n_points, [=] MPM_HOST_DEVICE(const int i) {
         if (p.material[i] < 0)
           return;
-        Real x[dim], lp[dim], mv[dim];
+        Real x[dim], lp[dim], v_new[dim], mv[dim];
         for (int d = 0; d < dim; ++d)
           {
             x[d]  = p.position[d][i];
             lp[d] = p.domain_half_length[d][i];
-            mv[d] = p.mass[i] * p.velocity[d][i];
           }
+        updated_point_velocity<dim, Shape>(g, p, s, dt, i, x, lp, v_new);
+        const Real m = p.mass[i];
+        for (int d = 0; d < dim; ++d)
+          {
+            p.velocity[d][i] = v_new[d];
+            mv[d]            = m * v_new[d];
+          }
+        Real *targets[dim];
+        for (int d = 0; d < dim; ++d)
+          targets[d] = g.momentum[d];
         for_each_stencil_node<dim, Shape>(g, x, lp, [&](const int n, const Real N, const Real *) {
+          Real values[dim];
           for (int d = 0; d < dim; ++d)
-            Backend::add(&g.momentum[d][n], N * mv[d]);
+            values[d] = N * mv[d];
+          Backend::template add_to_node<dim>(targets, n, values);
         });
       });
     }
@@ -391,8 +431,9 @@ namespace mpm
         const int  c    = g.lattice_cell(x);
         const Real V    = p.volume[i];
         const Real mean = (p.stress[0][i] + p.stress[1][i] + p.stress[2][i]) / Real(3);
-        Backend::add(&g.cell_volume[c], V);
-        Backend::add(&g.cell_pressure_volume[c], V * mean);
+        Real *const targets[2] = {g.cell_volume, g.cell_pressure_volume};
+        const Real  values[2]  = {V, V * mean};
+        Backend::template add_to_node<2>(targets, c, values);
       });
       backend.gather_points(p.n_points, [=] MPM_HOST_DEVICE(const int i) {
         if (p.material[i] < 0)
@@ -466,8 +507,7 @@ namespace mpm
           exchange.sum_nodal(mass_and_momentum, dim + 1);
           exchange.sum_nodal(forces, dim);
           update_grid(backend, g, s, dt);
-          grid_to_particle_velocity<dim, Shape>(backend, g, p, s, dt);
-          remap_momentum<dim, Shape>(backend, g, p);
+          grid_to_particle_velocity_and_remap<dim, Shape>(backend, g, p, s, dt);
           exchange.sum_nodal(momentum, dim);
           velocity_from_momentum(backend, g, s.mass_tolerance);
           grid_to_particle_kinematics<dim, Shape>(backend, g, p, materials, s, dt, true, true);

@@ -37,12 +37,15 @@ namespace mpm
     // The step calls group_points before scatters (see step.h, group_for_scatter).
     static constexpr bool colours_scatter = true;
 
-    // MPM_HOST_DEVICE only so that nvcc accepts the step's __host__ __device__ lambdas
-    // instantiated with this backend in a .cu file; it only ever runs on the host.
-    template <typename T>
-    MPM_HOST_DEVICE static void add(T *target, const T value)
+    // Scatter adds (step.h): targets[k][entry] += values[k] for k < K. A plain +=: the
+    // colouring keeps concurrent slabs apart. MPM_HOST_DEVICE only so that nvcc accepts
+    // the step's __host__ __device__ lambdas instantiated with this backend in a .cu file;
+    // it only ever runs on the host.
+    template <int K, typename T>
+    MPM_HOST_DEVICE static void add_to_node(T *const *targets, const int entry, const T *values)
     {
-      *target += value;
+      for (int k = 0; k < K; ++k)
+        targets[k][entry] += values[k];
     }
 
     template <typename F>

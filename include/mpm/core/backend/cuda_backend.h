@@ -40,6 +40,25 @@ namespace mpm
         f(i);
     }
 
+    // The gather loops (G2P kinematics with the constitutive update: 146 registers
+    // unbounded, 18% occupancy on P1) with a register cap from a minimum number of
+    // resident blocks of gather_block_size threads; 0: no cap. 5 blocks (102 registers,
+    // some spilling) took P1's kinematics from 6.27 to 4.80 ms per step at 12.8M points,
+    // 4 blocks to 5.23 ms (H100, doc/performance.md).
+#if !defined(MPM_GATHER_MIN_BLOCKS)
+#  define MPM_GATHER_MIN_BLOCKS 5
+#endif
+#if MPM_GATHER_MIN_BLOCKS > 0
+    constexpr int gather_block_size = 128;
+    template <typename F>
+    __global__ void __launch_bounds__(gather_block_size, MPM_GATHER_MIN_BLOCKS) gather_kernel_bounded(const int n, F f)
+    {
+      const int i = static_cast<int>(blockIdx.x) * static_cast<int>(blockDim.x) + static_cast<int>(threadIdx.x);
+      if (i < n)
+        f(i);
+    }
+#endif
+
     // Block-level tree reduction in shared memory (blockDim.x a power of two).
     template <typename T, typename Combine>
     __device__ T block_reduce(T value, T *shared, Combine &combine)
@@ -85,6 +104,16 @@ namespace mpm
       if (threadIdx.x == 0)
         *result = acc;
     }
+    // Shared memory where the lanes of a warp stage the values they add into one node
+    // (CudaBackend::add_to_node): 8 warps x 32 lanes x 64 bytes, 16 KB per block of a
+    // kernel that scatters.
+    constexpr int    max_staging_threads       = 256;
+    constexpr size_t max_staged_bytes_per_lane = 64;
+    __device__ inline unsigned char *staging_area()
+    {
+      __shared__ alignas(16) unsigned char bytes[max_staging_threads * max_staged_bytes_per_lane];
+      return bytes;
+    }
   } // namespace cuda_detail
 
   class CudaBackend
@@ -122,15 +151,59 @@ namespace mpm
       cudaFreeHost(host_result);
     }
 
-    // Scatter-add into a nodal value: an atomic on the device, a plain add on the
-    // host (the lambdas are __host__ __device__, so a host instantiation exists).
-    template <typename T>
-    MPM_HOST_DEVICE static void add(T *target, const T value)
+    // Scatter adds (step.h): targets[k][entry] += values[k] for k < K, called by every
+    // point for each node (or cell) it adds into. On the device, lanes of a warp that
+    // add into the same entry in a run of neighbouring lanes sum their values first: the
+    // run stages its K values per lane in shared memory, then lane j of the run sums value
+    // j (j + length, ... for runs shorter than K) over the run's lanes and issues the one
+    // atomicAdd. Points sorted by stencil (backend/cuda_point_order.h) come in runs of 4
+    // (2D) or 8 (3D), so the L2 sees that many times fewer atomics, for a few shared-memory
+    // accesses per value. An unsorted warp is still right, only less reduced. A warp that
+    // is not fully converged (a removed point, the last partial warp, a node outside the
+    // lattice), or a block larger than the staging area, adds lane by lane. On the host
+    // (the lambdas are __host__ __device__, so a host instantiation exists) a plain +=.
+    template <int K, typename T>
+    MPM_HOST_DEVICE static void add_to_node(T *const *targets, const int entry, const T *values)
     {
 #if defined(__CUDA_ARCH__)
-      atomicAdd(target, value);
+      using cuda_detail::max_staged_bytes_per_lane;
+      using cuda_detail::max_staging_threads;
+      static_assert(K * sizeof(T) <= max_staged_bytes_per_lane, "too many values per node for the staging area");
+      constexpr unsigned all = 0xffffffffu;
+      const int          lane = static_cast<int>(threadIdx.x) & 31;
+      bool               runs = __activemask() == all && blockDim.x <= max_staging_threads;
+      unsigned           heads = 0;
+      if (runs)
+        {
+          const int previous = __shfl_up_sync(all, entry, 1);
+          heads              = __ballot_sync(all, lane == 0 || previous != entry);
+          runs               = heads != all; // all heads: no run longer than one lane
+        }
+      if (!runs)
+        {
+          for (int k = 0; k < K; ++k)
+            atomicAdd(&targets[k][entry], values[k]);
+          return;
+        }
+      const int      first  = 31 - __clz(static_cast<int>(heads & (all >> (31 - lane))));
+      const unsigned later  = lane == 31 ? 0u : heads & (all << (lane + 1));
+      const int      last   = later != 0u ? __ffs(static_cast<int>(later)) - 2 : 31;
+      const int      length = last - first + 1;
+      T *staged = reinterpret_cast<T *>(cuda_detail::staging_area()) + (threadIdx.x >> 5) * 32 * K;
+      for (int k = 0; k < K; ++k)
+        staged[lane * K + k] = values[k];
+      __syncwarp();
+      for (int k = lane - first; k < K; k += length)
+        {
+          T sum = staged[first * K + k];
+          for (int l = first + 1; l <= last; ++l)
+            sum += staged[l * K + k];
+          atomicAdd(&targets[k][entry], sum);
+        }
+      __syncwarp(); // the staging area is reused by the next call
 #else
-      *target += value;
+      for (int k = 0; k < K; ++k)
+        targets[k][entry] += values[k];
 #endif
     }
 
@@ -143,7 +216,18 @@ namespace mpm
     template <typename F>
     void gather_points(const int n, F &&f)
     {
+#if MPM_GATHER_MIN_BLOCKS > 0
+      if (n <= 0)
+        return;
+      using FT = typename std::decay<F>::type;
+      constexpr int threads = cuda_detail::gather_block_size;
+      begin_timing();
+      cuda_detail::gather_kernel_bounded<FT><<<(n + threads - 1) / threads, threads, 0, stream>>>(n, f);
+      MPM_CUDA_CHECK_LAUNCH();
+      end_timing();
+#else
       launch(n, std::forward<F>(f));
+#endif
     }
 
     template <typename F>
@@ -231,7 +315,8 @@ namespace mpm
         MPM_CUDA_CHECK(cudaFuncGetAttributes(&attributes, cuda_detail::for_each_kernel<FT>));
         return attributes.maxThreadsPerBlock;
       }();
-      const int threads = block_size < max_threads ? block_size : max_threads;
+      // Whole warps: add_to_node's lane arithmetic assumes lane = threadIdx.x % 32.
+      const int threads = ((block_size < max_threads ? block_size : max_threads) / 32) * 32;
       const int blocks  = (n + threads - 1) / threads;
       begin_timing();
       cuda_detail::for_each_kernel<FT><<<blocks, threads, 0, stream>>>(n, f);

@@ -74,15 +74,15 @@ namespace mpm
     size_t size() const { return n; }
     size_t bytes() const { return n * sizeof(T); }
 
-  private:
-    T     *ptr = nullptr;
-    size_t n   = 0;
-
     void swap(DeviceArray &other) noexcept
     {
       std::swap(ptr, other.ptr);
       std::swap(n, other.n);
     }
+
+  private:
+    T     *ptr = nullptr;
+    size_t n   = 0;
   };
 
   template <int dim, typename Real>
@@ -97,50 +97,12 @@ namespace mpm
 
     void upload(const HostPoints<dim, Real> &h)
     {
-      for (int d = 0; d < dim; ++d)
-        {
-          position[d].upload(h.position[d]);
-          velocity[d].upload(h.velocity[d]);
-          domain_half_length[d].upload(h.domain_half_length[d]);
-          initial_domain_half_length[d].upload(h.initial_domain_half_length[d]);
-        }
-      for (int c = 0; c < n_voigt; ++c)
-        {
-          stress[c].upload(h.stress[c]);
-          strain[c].upload(h.strain[c]);
-        }
-      for (int c = 0; c < dim * dim; ++c)
-        deformation_gradient[c].upload(h.deformation_gradient[c]);
-      mass.upload(h.mass);
-      volume.upload(h.volume);
-      initial_volume.upload(h.initial_volume);
-      plastic_strain.upload(h.plastic_strain);
-      material_field.upload(h.material_field);
-      material.upload(h.material);
+      for_each_point_array<dim>(*this, h, [](auto &device, const auto &host) { device.upload(host); });
     }
 
     void download(HostPoints<dim, Real> &h) const
     {
-      for (int d = 0; d < dim; ++d)
-        {
-          position[d].download(h.position[d]);
-          velocity[d].download(h.velocity[d]);
-          domain_half_length[d].download(h.domain_half_length[d]);
-          initial_domain_half_length[d].download(h.initial_domain_half_length[d]);
-        }
-      for (int c = 0; c < n_voigt; ++c)
-        {
-          stress[c].download(h.stress[c]);
-          strain[c].download(h.strain[c]);
-        }
-      for (int c = 0; c < dim * dim; ++c)
-        deformation_gradient[c].download(h.deformation_gradient[c]);
-      mass.download(h.mass);
-      volume.download(h.volume);
-      initial_volume.download(h.initial_volume);
-      plastic_strain.download(h.plastic_strain);
-      material_field.download(h.material_field);
-      material.download(h.material);
+      for_each_point_array<dim>(*this, h, [](const auto &device, auto &host) { device.download(host); });
     }
 
     // Bytes of device memory held per point.

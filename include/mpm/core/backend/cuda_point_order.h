@@ -1,0 +1,144 @@
+// Sorting device-resident points by the first lattice node of their scatter stencil.
+// Points with the same first node share all their stencil nodes, so after the sort
+// neighbouring lanes of a warp hold the same node at every stencil position and the
+// CUDA backend's add_to_node sums each run of them before one atomic: with 2 points per
+// cell and direction, runs of 4 (2D) or 8 (3D) points. Sorting by cell would not do:
+// the points of one cell start their GIMP stencils at different nodes.
+//
+// The sort is a radix sort of the keys (CUB, part of the CUDA toolkit) and a gather of
+// every point array through the permutation. The step's results do not depend on the
+// order except through the rounding of the nodal sums (which the atomics reorder
+// anyway). Each slot remembers the index its point had at the last reset(), so the
+// owner can hand the points back in the order it uploaded them.
+//
+// Include from .cu files only (needs nvcc).
+#pragma once
+
+#include <mpm/core/backend/cuda_backend.h>
+#include <mpm/core/backend/cuda_storage.h>
+#include <mpm/core/views.h>
+
+#include <cub/device/device_radix_sort.cuh>
+
+#include <vector>
+
+namespace mpm
+{
+  namespace cuda_detail
+  {
+    template <typename T>
+    __global__ void gather_kernel(const int n, const int *permutation, const T *in, T *out)
+    {
+      const int i = static_cast<int>(blockIdx.x * blockDim.x + threadIdx.x);
+      if (i < n)
+        out[i] = in[permutation[i]];
+    }
+  } // namespace cuda_detail
+
+  template <int dim, typename Real>
+  class PointOrder
+  {
+  public:
+    // The points now on the device are the reference order: slot i holds point i.
+    void reset(CudaBackend &backend, const int n_points)
+    {
+      original.resize(n_points);
+      int *o = original.data();
+      backend.for_each_node(n_points, [=] __device__(const int i) { o[i] = i; });
+    }
+
+    // Sorts the points by the first lattice node of their stencil (removed points last),
+    // permuting every point array; the point views taken before are invalid afterwards.
+    template <typename Shape>
+    void sort(CudaBackend &backend, const GridView<dim, Real> &g, DevicePoints<dim, Real> &points)
+    {
+      const int n = points.size();
+      if (n == 0)
+        return;
+      if (static_cast<int>(original.size()) != n)
+        reset(backend, n);
+      keys.resize(n);
+      sorted_keys.resize(n);
+      identity.resize(n);
+      permutation.resize(n);
+
+      long n_lattice_nodes = 1;
+      for (int d = 0; d < dim; ++d)
+        n_lattice_nodes *= g.n_cells[d] + 1;
+      const int removed_key = static_cast<int>(n_lattice_nodes);
+      const PointsView<dim, Real> p = points.view();
+      int *key = keys.data(), *iota = identity.data();
+      backend.for_each_node(n, [=] __device__(const int i) {
+        iota[i] = i;
+        if (p.material[i] < 0)
+          {
+            key[i] = removed_key;
+            return;
+          }
+        long lattice = 0;
+        for (int d = dim - 1; d >= 0; --d)
+          {
+            constexpr int n_w = Shape::n_per_direction;
+            int           first;
+            Real          w[n_w], dw[n_w];
+            Shape::weights_1d((p.position[d][i] - g.origin[d]) / g.h, p.domain_half_length[d][i] / g.h, first, w,
+                              dw);
+            first   = first < 0 ? 0 : (first > g.n_cells[d] ? g.n_cells[d] : first);
+            lattice = lattice * (g.n_cells[d] + 1) + first;
+          }
+        key[i] = static_cast<int>(lattice);
+      });
+
+      int end_bit = 1;
+      while ((1L << end_bit) <= n_lattice_nodes)
+        ++end_bit;
+      size_t temp_bytes = 0;
+      MPM_CUDA_CHECK(cub::DeviceRadixSort::SortPairs(nullptr, temp_bytes, keys.data(), sorted_keys.data(),
+                                                     identity.data(), permutation.data(), n, 0, end_bit,
+                                                     backend.get_stream()));
+      if (temp_bytes > temp.size())
+        temp.resize(temp_bytes);
+      MPM_CUDA_CHECK(cub::DeviceRadixSort::SortPairs(temp.data(), temp_bytes, keys.data(), sorted_keys.data(),
+                                                     identity.data(), permutation.data(), n, 0, end_bit,
+                                                     backend.get_stream()));
+
+      for_each_point_array<dim>(points, points, [&](auto &array, auto &) { permute(backend, array); });
+      permute(backend, original);
+    }
+
+    // original_index()[slot]: the index the point in that slot had at the last reset().
+    const DeviceArray<int> &original_index() const { return original; }
+
+    // Host arrays in the current slot order, written back in the reference order.
+    template <typename Host>
+    static void restore_reference_order(const std::vector<int> &original_of_slot, const Host &slots, Host &reference)
+    {
+      for_each_point_array<dim>(reference, slots, [&](auto &out, const auto &in) {
+        out.resize(in.size());
+        for (size_t i = 0; i < in.size(); ++i)
+          out[original_of_slot[i]] = in[i];
+      });
+    }
+
+  private:
+    DeviceArray<int>  keys, sorted_keys, identity, permutation, original, int_scratch;
+    DeviceArray<Real> real_scratch;
+    DeviceArray<char> temp;
+
+    template <typename T>
+    void permute(CudaBackend &backend, DeviceArray<T> &array)
+    {
+      DeviceArray<T> &scratch = scratch_for(array);
+      scratch.resize(array.size());
+      const int n       = static_cast<int>(array.size());
+      const int threads = 256;
+      cuda_detail::gather_kernel<T><<<(n + threads - 1) / threads, threads, 0, backend.get_stream()>>>(
+        n, permutation.data(), array.data(), scratch.data());
+      MPM_CUDA_CHECK_LAUNCH();
+      array.swap(scratch);
+    }
+
+    DeviceArray<Real> &scratch_for(DeviceArray<Real> &) { return real_scratch; }
+    DeviceArray<int>  &scratch_for(DeviceArray<int> &) { return int_scratch; }
+  };
+} // namespace mpm
