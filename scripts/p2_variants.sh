@@ -3,7 +3,8 @@
 # (prm/granular_collapse_3d.prm, 512,000 points, 1 s) with Backend = cuda in variants that
 # separate physics from hand-over effects: field writing off, but the hand-over to deal.II
 # (store, re-sort, load) still happens every "Output interval". Prints wall time, steps, the
-# final toe (max x) and height (max z) from history.csv. Usage: BIN=dir bash scripts/p2_variants.sh
+# final toe (max x) and height (max z) from history.csv.
+# Usage: BIN=dir bash scripts/p2_variants.sh [variant names]
 set -u -o pipefail
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
 BIN=$(cd "${BIN:-$ROOT/build-cuda/dev}" && pwd)
@@ -50,6 +51,12 @@ PY
   [ $rc = 0 ] || grep -E "error|unstable" "$WORK/$name.log" | head -3
   grep -E "MPM step|output|migrate" "$WORK/$name.log" | head -3
 }
-variant flip1_noavg_handover0.1 0.1 1 false
-variant flip0.99_avg_handover0.1 0.1 0.99 true
-variant flip0.99_avg_nohandover 0 0.99 true
+# Names given on the command line run only those variants.
+for name in ${@:-flip1_noavg_handover0.1 flip0.99_avg_handover0.1 flip0.99_avg_nohandover}; do
+  case $name in
+    flip1_noavg_handover0.1) variant "$name" 0.1 1 false ;;
+    flip0.99_avg_handover0.1) variant "$name" 0.1 0.99 true ;;
+    flip0.99_avg_nohandover) variant "$name" 0 0.99 true ;;
+    *) echo "unknown variant $name" ;;
+  esac
+done

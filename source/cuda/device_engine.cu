@@ -2,6 +2,7 @@
 // step.h run by CudaBackend over DevicePoints / DeviceGrid (backend/cuda_storage.h).
 // Includes core headers only, never deal.II.
 #include <mpm/core/backend/cuda_backend.h>
+#include <mpm/core/backend/cuda_point_order.h>
 #include <mpm/core/backend/cuda_storage.h>
 #include <mpm/cuda/device_engine.h>
 
@@ -83,6 +84,8 @@ namespace mpm
       CudaBackend                  backend;
       DeviceGrid<dim, double>      grid;
       DevicePoints<dim, double>    points;
+      PointOrder<dim, double>      order; // points sorted by stencil every sort_interval steps
+      long                         steps_since_upload = 0;
       DeviceMaterials<double>      materials;
       DeviceArray<double>          cell_volume, cell_pressure_volume;
       long                         n_lattice_cells = 1;
@@ -126,13 +129,27 @@ namespace mpm
     void DeviceEngine<dim>::upload_points(const HostPoints<dim, double> &p)
     {
       impl->points.upload(p);
+      impl->order.reset(impl->backend, impl->points.size());
+      impl->steps_since_upload = 0;
     }
 
     template <int dim>
     void DeviceEngine<dim>::download_points(HostPoints<dim, double> &p) const
     {
       impl->backend.synchronize();
-      impl->points.download(p);
+      HostPoints<dim, double> slots;
+      std::vector<int>        original;
+      impl->points.download(slots);
+      impl->order.original_index().download(original);
+      PointOrder<dim, double>::restore_reference_order(original, slots, p);
+    }
+
+    template <int dim>
+    void DeviceEngine<dim>::set_sort_interval(const int steps)
+    {
+      if (steps < 0)
+        throw std::invalid_argument("DeviceEngine::set_sort_interval: the interval must be >= 0");
+      sort_interval = steps;
     }
 
     template <int dim>
@@ -156,6 +173,14 @@ namespace mpm
     StepReduction<double> DeviceEngine<dim>::step(const StepSettings<dim, double> &s, const double dt)
     {
       GridView<dim, double> g = impl->grid.view();
+      if (sort_interval > 0 && impl->steps_since_upload % sort_interval == 0)
+        {
+          if (impl->shape == ShapeFunction::gimp)
+            impl->order.template sort<GimpShape>(impl->backend, g, impl->points);
+          else
+            impl->order.template sort<LinearShape>(impl->backend, g, impl->points);
+        }
+      ++impl->steps_since_upload;
       if (s.pressure_averaging)
         {
           if (!HasCellArrays<GridView<dim, double>>::value)

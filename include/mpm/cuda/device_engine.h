@@ -55,8 +55,12 @@ namespace mpm
 
       // Host -> device: the whole point set (its size may have changed).
       void upload_points(const HostPoints<dim, double> &points);
-      // Device -> host: every point array (points that left the grid have material < 0).
+      // Device -> host: every point array (points that left the grid have material < 0),
+      // in the order of the last upload, whatever order the device keeps them in.
       void download_points(HostPoints<dim, double> &points) const;
+      // The device re-sorts its points by stencil every `steps` steps (0: never), so
+      // that the nodal sums of a warp are reduced before the atomics; default 20.
+      void set_sort_interval(int steps);
       // Device -> host: nodal mass, momentum, force and velocity into the host grid's
       // arrays (same numbering and length as at construction).
       void download_nodal(const GridView<dim, double> &host_grid) const;
@@ -71,6 +75,7 @@ namespace mpm
     private:
       struct Impl;
       std::unique_ptr<Impl> impl;
+      int                   sort_interval = 20;
     };
   } // namespace cuda
 } // namespace mpm
