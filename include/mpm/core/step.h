@@ -223,13 +223,14 @@ namespace mpm
                                                        const StepSettings<dim, Real> &s, const Real dt, const int i,
                                                        const Real x[dim], const Real lp[dim], Real v_new[dim])
     {
-      Real a[dim] = {}, v_pic[dim] = {};
+      Real       a[dim] = {}, v_pic[dim] = {};
+      const bool pic    = s.flip_fraction != Real(1); // pure FLIP reads no nodal velocity
       for_each_stencil_node<dim, Shape>(g, x, lp, [&](const int n, const Real N, const Real *) {
         for (int d = 0; d < dim; ++d)
-          {
-            a[d] += N * g.force[d][n];
+          a[d] += N * g.force[d][n];
+        if (pic)
+          for (int d = 0; d < dim; ++d)
             v_pic[d] += N * g.velocity[d][n];
-          }
       });
       for (int d = 0; d < dim; ++d)
         {
