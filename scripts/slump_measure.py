@@ -11,7 +11,8 @@ exceeds --threshold has failed. Reported, all from the configuration at T0 unles
                  and m^2 per metre of width: divided by the extent in y in 3D);
   crown          the smallest x of a failed point within one --bin of the top surface of its column:
                  where the scarp cuts the top; and the crest (largest x of the flat top, points within
-                 --bin of the highest surface) for comparison;
+                 --bin of the highest surface) for comparison; in 3D also per slab of width --bin
+                 along y: its smallest, largest and standard deviation (a straight or curved crown);
   depth          per column of width --bin, the surface (highest point) minus the lowest failed point:
                  the depth of the failure surface; its largest value and where;
   run-out        the front of the slope material (points starting above --base-top) at T, minus its
@@ -71,6 +72,11 @@ def measure(start, end, threshold, bin_width, base_top, back):
     }
     near_top = failed & (z0 > surf - bin_width)
     r["crown_x"] = float(x0[near_top, 0].min()) if near_top.any() else float("nan")
+    if dim == 3:  # the crown along the width: straight or curved
+        slab = np.floor((x0[:, 1] - x0[:, 1].min()) / bin_width + 1e-9).astype(int)
+        crowns = [x0[near_top & (slab == k), 0].min() for k in np.unique(slab) if (near_top & (slab == k)).any()]
+        r["crown_x_across_width"] = {"n_slabs": len(crowns), "min": float(np.min(crowns)),
+                                     "max": float(np.max(crowns)), "std": float(np.std(crowns))}
     depth, where = 0.0, float("nan")
     for c in np.unique(col[failed]):
         d = surface[c] - z0[failed & (col == c)].min()
@@ -117,8 +123,13 @@ def main():
     print(f"  displaced > {r['threshold']:g} m: {r['n_displaced']} points ({100 * r['fraction_displaced']:.1f}%), "
           f"{r['volume_displaced']:.1f} m^3 = {r['area_displaced_per_width']:.1f} m^2 per metre of width; "
           f"largest displacement {r['max_displacement']:.2f} m")
+    bin_width = args.bin
     print(f"  crown at x = {r['crown_x']:.2f} m (crest at {r['crest_x']:.2f} m); failure surface down to "
           f"{r['max_failure_depth']:.2f} m below the surface (at x = {r['max_failure_depth_x']:.1f} m)")
+    if "crown_x_across_width" in r:
+        c = r["crown_x_across_width"]
+        print(f"  crown across the width ({c['n_slabs']} slabs of {bin_width:g} m): x from {c['min']:.2f} to "
+              f"{c['max']:.2f} m, standard deviation {c['std']:.2f} m")
     if "run_out" in r:
         print(f"  slope material: toe {r['toe_start']:.2f} m -> front {r['front']:.2f} m, run-out "
               f"{r['run_out']:.2f} m")
