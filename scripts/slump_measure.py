@@ -9,6 +9,8 @@ elastic state) and the output at time T (default: the last). A point whose displ
 exceeds --threshold has failed. Reported, all from the configuration at T0 unless said otherwise:
   displaced      number and fraction of the points that failed, and the volume they fill (m^3,
                  and m^2 per metre of width: divided by the extent in y in 3D);
+  crest drop     the crest height at T0 minus the highest point at T within half a column of the
+                 crest's x;
   crown          the smallest x of a failed point within one --bin of the top surface of its column:
                  where the scarp cuts the top; and the crest (largest x of the flat top, points within
                  --bin of the highest surface) for comparison; in 3D also per slab of width --bin
@@ -51,6 +53,8 @@ def measure(start, end, threshold, bin_width, base_top, back):
     x0, x1 = start["position"][i0], end["position"][i1]
     vol0 = start["volume"][i0]
     dim = x0.shape[1]
+    if dim == 3 and not np.any(start["position"][:, 2]) and not np.any(end["position"][:, 2]):
+        dim, x0, x1 = 2, x0[:, :2], x1[:, :2]  # 2D output, written with z = 0
     disp = np.linalg.norm(x1 - x0, axis=1)
     failed = disp > threshold
     z0 = x0[:, dim - 1]
@@ -70,6 +74,12 @@ def measure(start, end, threshold, bin_width, base_top, back):
         "max_displacement": float(disp.max()),
         "crest_x": float(x0[z0 > top - bin_width, 0].max()),
     }
+    # Crest drop: the surface above the crest at T (highest point within half a column of the
+    # crest's x, in the deformed configuration) against the crest height at T0.
+    crest = r["crest_x"]
+    above = np.abs(x1[:, 0] - crest) <= 0.5 * bin_width
+    r["crest_height"] = float(top)
+    r["crest_drop"] = float(top - x1[above, dim - 1].max()) if above.any() else float(top)
     near_top = failed & (z0 > surf - bin_width)
     r["crown_x"] = float(x0[near_top, 0].min()) if near_top.any() else float("nan")
     if dim == 3:  # the crown along the width: straight or curved
@@ -126,6 +136,7 @@ def main():
     bin_width = args.bin
     print(f"  crown at x = {r['crown_x']:.2f} m (crest at {r['crest_x']:.2f} m); failure surface down to "
           f"{r['max_failure_depth']:.2f} m below the surface (at x = {r['max_failure_depth_x']:.1f} m)")
+    print(f"  crest (x = {r['crest_x']:.2f} m, height {r['crest_height']:.2f} m) dropped by {r['crest_drop']:.2f} m")
     if "crown_x_across_width" in r:
         c = r["crown_x_across_width"]
         print(f"  crown across the width ({c['n_slabs']} slabs of {bin_width:g} m): x from {c['min']:.2f} to "
