@@ -21,7 +21,8 @@ exceeds --threshold has failed. Reported, all from the configuration at T0 unles
                  toe at T0 (largest x at T0);
   back           the largest displacement of the points starting at x < --back: the ground behind the
                  slide, which must stay at rest for a slump.
-Checks (exit status 1 if one fails): --fraction LO,HI  --crown LO,HI  --depth LO,HI  --back-max D.
+Checks (exit status 1 if one fails): --fraction LO,HI  --crown LO,HI  --depth LO,HI  --back-max D
+  --run-out LO,HI  --crest-drop LO,HI.
 """
 import argparse
 import json
@@ -123,6 +124,8 @@ def main():
     parser.add_argument("--crown", type=bounds)
     parser.add_argument("--depth", type=bounds)
     parser.add_argument("--back-max", type=float)
+    parser.add_argument("--run-out", type=bounds)
+    parser.add_argument("--crest-drop", type=bounds)
     args = parser.parse_args()
 
     start = mpm_results.particles_at(args.output_dir, output_index(args.output_dir, args.start))
@@ -153,6 +156,8 @@ def main():
     for name, value, lim in (("fraction displaced", r["fraction_displaced"], args.fraction),
                              ("crown x", r["crown_x"], args.crown),
                              ("failure depth", r["max_failure_depth"], args.depth),
+                             ("run-out", r.get("run_out", float("nan")), args.run_out),
+                             ("crest drop", r["crest_drop"], args.crest_drop),
                              ("back displacement", r["back_max_displacement"],
                               None if args.back_max is None else (0.0, args.back_max))):
         if lim is None:

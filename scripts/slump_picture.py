@@ -1,6 +1,6 @@
 #!/usr/bin/python3
-"""Pictures of 3D slump runs (V5), one panel per run:
-  side view (default): x-z, coloured by accumulated plastic strain: the shear zones;
+"""Pictures of slump runs (V5 in 3D, V4 in 2D), one panel per run:
+  side view (default): x-z (x-y in 2D), coloured by accumulated plastic strain: the shear zones;
   plan view (--plan START): the top surface seen from above at time START (the plasticity start),
     coloured by the displacement since then: where the scarp (crown) cuts the top, straight or curved.
 Usage:
@@ -41,11 +41,12 @@ fig, axes = plt.subplots(len(runs), 1, figsize=(9, height * len(runs)), squeeze=
 for ax, (label, out, time) in zip(axes[:, 0], runs):
     p = mpm_results.particles_at(out, output_index(out, time))
     if args.plan is None:
-        x, z = p["position"][:, 0], p["position"][:, 2]
+        vertical = 2 if np.any(p["position"][:, 2]) else 1  # 2D output has z = 0
+        x, z = p["position"][:, 0], p["position"][:, vertical]
         order = np.argsort(p["plastic_strain"])  # strongest shear drawn on top
         sc = ax.scatter(x[order], z[order], c=np.clip(p["plastic_strain"][order], 0, 1), s=1.5, cmap="inferno_r",
                         vmin=0, vmax=1)
-        ax.set_ylabel("z (m)")
+        ax.set_ylabel("z (m)" if vertical == 2 else "y (m)")
         fig.colorbar(sc, ax=ax, label="plastic strain (clipped at 1)", shrink=0.8)
     else:
         s = by_id(mpm_results.particles_at(out, output_index(out, args.plan)))
