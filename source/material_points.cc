@@ -4,6 +4,7 @@
 
 #include <deal.II/base/mpi.h>
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <memory>
@@ -76,20 +77,50 @@ namespace mpm
 
   namespace
   {
-    // Height of the polygon's upper boundary above horizontal coordinate x.
-    double polygon_top(const std::vector<std::array<double, 2>> &polygon, const double x)
+    // Length of the vertical line through horizontal coordinate x that lies inside the
+    // polygon above height z (the polygon's edges cut the line into inside intervals).
+    double polygon_thickness_above(const std::vector<std::array<double, 2>> &polygon, const double x,
+                                   const double z)
     {
-      double top = -1e300;
+      std::vector<double> cuts;
       for (size_t i = 0, j = polygon.size() - 1; i < polygon.size(); j = i++)
         {
           const auto &a = polygon[j], &b = polygon[i];
-          if ((a[0] <= x && x <= b[0]) || (b[0] <= x && x <= a[0]))
-            {
-              const double t = a[0] == b[0] ? 0.0 : (x - a[0]) / (b[0] - a[0]);
-              top            = std::max(top, a[1] + t * (b[1] - a[1]));
-            }
+          // Half-open in x: a vertex shared by two edges is counted once; vertical edges never.
+          if ((a[0] <= x && x < b[0]) || (b[0] <= x && x < a[0]))
+            cuts.push_back(a[1] + (x - a[0]) / (b[0] - a[0]) * (b[1] - a[1]));
         }
-      return top;
+      std::sort(cuts.begin(), cuts.end());
+      double thickness = 0;
+      for (size_t k = 0; k + 1 < cuts.size(); k += 2)
+        thickness += std::max(0.0, cuts[k + 1] - std::max(cuts[k], z));
+      return thickness;
+    }
+
+    // Weight per unit area of the material of all bodies above point x, for the geostatic
+    // initial stress: the sum over the bodies of density times the body's thickness above x
+    // on the vertical through it. Stacked bodies (layers) load the ones below them.
+    template <int dim>
+    double overburden(const Parameters &parameters, const double *x)
+    {
+      double weight = 0;
+      for (const BodyParameters &body : parameters.bodies)
+        {
+          // A polygon gives x through its vertices; its other horizontal extent (y in 3D),
+          // like a box's, through the corners.
+          bool      covers = true;
+          const int first  = body.shape == "polygon" ? 1 : 0;
+          for (int d = first; d < dim - 1; ++d)
+            covers = covers && body.lower[d] <= x[d] && x[d] <= body.upper[d];
+          if (!covers)
+            continue;
+          const double thickness =
+            body.shape == "polygon" ?
+              polygon_thickness_above(body.polygon, x[0], x[dim - 1]) :
+              std::max(0.0, body.upper[dim - 1] - std::max(body.lower[dim - 1], x[dim - 1]));
+          weight += body.density * thickness;
+        }
+      return weight;
     }
   } // namespace
 
@@ -182,8 +213,7 @@ namespace mpm
               }
             if (body.initial_stress == "geostatic")
               {
-                const double top = body.shape == "polygon" ? polygon_top(body.polygon, x[0]) : upper[dim - 1];
-                const double sv  = -body.density * g_vertical * std::max(0.0, top - x[dim - 1]);
+                const double sv = -g_vertical * overburden<dim>(parameters, x);
                 properties[Layout::stress + 0] = body.k0 * sv;
                 properties[Layout::stress + 1] = dim == 2 ? sv : body.k0 * sv;
                 properties[Layout::stress + 2] = dim == 2 ? body.k0 * sv : sv;

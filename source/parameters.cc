@@ -185,8 +185,9 @@ namespace mpm
         prm.declare_entry("Material", material_names.front(), Patterns::Anything(),
                           "Name of this body's material, one of the names in Materials/Names.");
         prm.declare_entry("Initial stress", "none", Patterns::Selection("none|geostatic"),
-                          "none: stress free. geostatic: vertical stress -rho |g| (depth below the body's top "
-                          "surface above the point), horizontal stresses K0 times it.");
+                          "none: stress free. geostatic: vertical stress -|g| times the weight per unit area of "
+                          "the material of all bodies above the point (sum of density x thickness; stacked "
+                          "bodies load the ones below), horizontal stresses K0 of this body times it.");
         prm.declare_entry("K0", "0.5", Patterns::Double(0), "Lateral earth pressure coefficient for geostatic.");
         prm.leave_subsection();
       }
