@@ -189,7 +189,8 @@ namespace mpm
           return body.shape != "polygon" || inside_polygon(px, pv, x[0], x[dim - 1]);
         });
 
-        const double g_vertical = std::abs(parameters.gravity[dim - 1]);
+        const double        g_vertical = std::abs(parameters.gravity[dim - 1]);
+        std::vector<double> properties(Layout::n_properties);
         for (int i = 0; i < points.size(); ++i, ++id)
           {
             double x[dim];
@@ -199,7 +200,7 @@ namespace mpm
             if (cell == grid.triangulation.end())
               continue; // another rank owns this point's cell
 
-            std::vector<double> properties(Layout::n_properties, 0.0);
+            std::fill(properties.begin(), properties.end(), 0.0);
             properties[Layout::mass]           = points.mass[i];
             properties[Layout::volume]         = points.volume[i];
             properties[Layout::initial_volume] = points.initial_volume[i];

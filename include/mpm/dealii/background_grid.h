@@ -17,7 +17,7 @@
 #include <deal.II/distributed/tria.h>
 #include <deal.II/dofs/dof_handler.h>
 #include <deal.II/fe/fe_q.h>
-#include <deal.II/fe/mapping_q1.h>
+#include <deal.II/fe/mapping_cartesian.h>
 #include <deal.II/lac/la_parallel_vector.h>
 
 #include <array>
@@ -71,7 +71,10 @@ namespace mpm
     dealii::parallel::distributed::Triangulation<dim> triangulation;
     dealii::FE_Q<dim>                         fe;
     dealii::DoFHandler<dim>                   dof_handler;
-    dealii::MappingQ1<dim>                    mapping;
+    // The cells are axis-parallel cubes: real <-> unit coordinates are a shift and a
+    // scaling, not MappingQ1's Newton iteration (point generation and every re-sort of
+    // the ParticleHandler map each point).
+    dealii::MappingCartesian<dim>             mapping;
     dealii::IndexSet                          locally_owned_dofs, locally_relevant_dofs;
     std::shared_ptr<const dealii::Utilities::MPI::Partitioner> partitioner;
 
