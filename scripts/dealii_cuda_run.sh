@@ -60,7 +60,8 @@ run p2_cuda "$WORK/p2_cuda.prm" 240
 cp "$WORK/p2_cuda/history.csv" "$OUT/p2_cuda_history.csv" 2>/dev/null
 grep -A12 "Total wallclock" "$OUT/p2_cuda.log"
 
-for h in 0.01 0.005; do
+# REDUCED_SIZES: cell sizes of the reduced copies run with both backends
+for h in ${REDUCED_SIZES:-0.01 0.005}; do
   tag=h$(awk "BEGIN{printf \"%d\", $h * 1000}")mm
   for b in cuda cpu; do
     make_prm "$P2" "$WORK/${tag}_$b.prm" $b "$h" "$WORK/${tag}_$b" 0.5
