@@ -6,7 +6,9 @@
 #include <mpm/core/backend/cuda_storage.h>
 #include <mpm/cuda/device_engine.h>
 
+#include <algorithm>
 #include <cstdio>
+#include <cstdlib>
 #include <stdexcept>
 #include <type_traits>
 #include <utility>
@@ -86,6 +88,10 @@ namespace mpm
       DevicePoints<dim, double>    points;
       PointOrder<dim, double>      order; // points sorted by stencil every sort_interval steps
       long                         steps_since_upload = 0;
+      // MPM_CUDA_KERNEL_TIMES=N: per-launch times of steps N..N+4 after an upload, printed
+      // once (what the profiler would say, without one; doc/performance.md).
+      long                         timed_from = -1, n_timed_steps = 0;
+      std::vector<double>          launch_ms;
       DeviceMaterials<double>      materials;
       DeviceArray<double>          cell_volume, cell_pressure_volume;
       long                         n_lattice_cells = 1;
@@ -103,6 +109,8 @@ namespace mpm
         throw std::runtime_error("no CUDA device: " + why);
       impl        = std::make_unique<Impl>();
       impl->shape = shape;
+      if (const char *from = std::getenv("MPM_CUDA_KERNEL_TIMES"))
+        impl->timed_from = std::atol(from);
       // The host grid description: geometry, lookup and masks, nodal arrays zeroed.
       HostGrid<dim, double> host;
       host.h   = g.h;
@@ -193,8 +201,32 @@ namespace mpm
           set_cell_arrays(g, impl->cell_volume.data(), impl->cell_pressure_volume.data(),
                           HasCellArrays<GridView<dim, double>>());
         }
-      return explicit_step<dim>(impl->backend, impl->shape, g, impl->points.view(), impl->materials.data(), s, dt,
-                                impl->exchange);
+      const long step_index = impl->steps_since_upload - 1;
+      const bool timed      = impl->timed_from >= 0 && step_index >= impl->timed_from && impl->n_timed_steps < 5;
+      impl->backend.enable_kernel_timing(timed);
+      const StepReduction<double> r = explicit_step<dim>(impl->backend, impl->shape, g, impl->points.view(),
+                                                         impl->materials.data(), s, dt, impl->exchange);
+      if (timed)
+        {
+          const std::vector<float> times = impl->backend.kernel_times_ms();
+          impl->launch_ms.resize(std::max(impl->launch_ms.size(), times.size()), 0.0);
+          for (size_t k = 0; k < times.size(); ++k)
+            impl->launch_ms[k] += times[k];
+          if (++impl->n_timed_steps == 5)
+            {
+              double total = 0;
+              for (const double t : impl->launch_ms)
+                total += t / 5;
+              std::printf("  CUDA per-launch times, steps %ld-%ld, %d points (mean of 5 steps, sum %.3f ms):",
+                          impl->timed_from, impl->timed_from + 4, impl->points.size(), total);
+              for (size_t k = 0; k < impl->launch_ms.size(); ++k)
+                std::printf(" %zu: %.3f", k, impl->launch_ms[k] / 5);
+              std::printf("\n");
+              std::fflush(stdout);
+              impl->backend.enable_kernel_timing(false);
+            }
+        }
+      return r;
     }
 
     template <int dim>
