@@ -2,29 +2,217 @@
 
 #include <deal.II/base/exceptions.h>
 #include <deal.II/base/mpi.h>
+#include <deal.II/base/utilities.h>
 #include <deal.II/numerics/data_out.h>
-#include <deal.II/particles/data_out.h>
 
 #include <filesystem>
 #include <iomanip>
+#include <memory>
 #include <sstream>
 
 namespace mpm
 {
+  namespace
+  {
+    using Ranges = std::vector<std::tuple<unsigned int, unsigned int, std::string,
+                                          dealii::DataComponentInterpretation::DataComponentInterpretation>>;
+
+    // Patches, names and vector ranges owned by value, so that a background thread can
+    // write them while the triangulation, the DoFHandler and the vectors move on.
+    template <int patch_dim, int spacedim>
+    class OwnedPatches : public dealii::DataOutInterface<patch_dim, spacedim>
+    {
+    public:
+      std::vector<dealii::DataOutBase::Patch<patch_dim, spacedim>> patches;
+      std::vector<std::string>                                     names;
+      Ranges                                                       ranges;
+
+    protected:
+      const std::vector<dealii::DataOutBase::Patch<patch_dim, spacedim>> &get_patches() const override
+      {
+        return patches;
+      }
+      std::vector<std::string> get_dataset_names() const override { return names; }
+      Ranges                   get_nonscalar_data_ranges() const override { return ranges; }
+    };
+
+    // DataOut whose built patches can be taken away (DataOut keeps pointers to the
+    // DoFHandler and the vectors, which the steps change).
+    template <int dim>
+    class GridDataOut : public dealii::DataOut<dim>
+    {
+    public:
+      std::unique_ptr<OwnedPatches<dim, dim>> take()
+      {
+        auto owned     = std::make_unique<OwnedPatches<dim, dim>>();
+        owned->names   = this->get_dataset_names();
+        owned->ranges  = this->get_nonscalar_data_ranges();
+        owned->patches = std::move(this->patches);
+        return owned;
+      }
+    };
+
+    // Piece and record names as DataOutInterface::write_vtu_with_pvtu_record writes them
+    // (one piece per rank): name_CCCCC.R.vtu and name_CCCCC.pvtu.
+    std::string piece_name(const std::string &name, const unsigned int counter, const unsigned int rank,
+                           const unsigned int n_ranks)
+    {
+      return name + "_" + dealii::Utilities::int_to_string(counter, 5) + "." +
+             dealii::Utilities::int_to_string(rank, dealii::Utilities::needed_digits(n_ranks - 1)) + ".vtu";
+    }
+    std::string record_name(const std::string &name, const unsigned int counter)
+    {
+      return name + "_" + dealii::Utilities::int_to_string(counter, 5) + ".pvtu";
+    }
+
+    // One rank's .vtu piece; on rank 0 also the .pvtu record and the .pvd time series.
+    template <int patch_dim, int spacedim>
+    void write_piece(const dealii::DataOutInterface<patch_dim, spacedim> &out, const std::string &directory,
+                     const std::string &name, const unsigned int counter, const unsigned int rank,
+                     const unsigned int n_ranks, const std::vector<std::pair<double, std::string>> &records)
+    {
+      const std::string piece = directory + "/" + piece_name(name, counter, rank, n_ranks);
+      std::ofstream     file(piece);
+      AssertThrow(file, dealii::ExcMessage("Parameter 'Output/Directory': cannot write '" + piece + "'."));
+      out.write_vtu(file);
+      AssertThrow(file, dealii::ExcMessage("Parameter 'Output/Directory': writing '" + piece + "' failed."));
+      if (rank != 0)
+        return;
+      std::vector<std::string> pieces;
+      for (unsigned int r = 0; r < n_ranks; ++r)
+        pieces.push_back(piece_name(name, counter, r, n_ranks));
+      std::ofstream pvtu(directory + "/" + record_name(name, counter));
+      out.write_pvtu_record(pvtu, pieces);
+      std::ofstream pvd(directory + "/" + name + ".pvd");
+      dealii::DataOutBase::write_pvd_record(pvd, records);
+    }
+
+    // Full-precision table of one rank's points: id, position, every property.
+    template <int dim>
+    void write_point_table(const PointSnapshot<dim> &snapshot, const std::string &file_name)
+    {
+      std::ofstream table(file_name);
+      AssertThrow(table, dealii::ExcMessage("Parameter 'Output/Directory': cannot write '" + file_name + "'."));
+      const auto names = PropertyLayout<dim>::names();
+      table << "id";
+      for (int d = 0; d < dim; ++d)
+        table << ",position_" << "xyz"[d];
+      std::vector<unsigned int> seen(names.size(), 0);
+      for (unsigned int k = 0; k < names.size(); ++k)
+        {
+          // Vector properties repeat their name: number their components.
+          unsigned int repeats = 0;
+          for (unsigned int j = 0; j < names.size(); ++j)
+            repeats += names[j] == names[k];
+          table << ',' << names[k];
+          if (repeats > 1)
+            table << '_' << "xyz"[seen[k]];
+          for (unsigned int j = k + 1; j < names.size(); ++j)
+            if (names[j] == names[k])
+              seen[j] = seen[k] + 1;
+        }
+      table << '\n' << std::setprecision(17);
+      const auto         &p = snapshot.points;
+      std::vector<double> values(PropertyLayout<dim>::n_properties);
+      for (int i = 0; i < p.size(); ++i)
+        {
+          if (p.material[i] < 0)
+            continue; // left the grid
+          snapshot.properties(i, values.data());
+          table << snapshot.labels->id[i];
+          for (int d = 0; d < dim; ++d)
+            table << ',' << p.position[d][i];
+          for (const double value : values)
+            table << ',' << value;
+          table << '\n';
+        }
+    }
+  } // namespace
+
+  template <int dim>
+  void PointDataOut<dim>::build_patches(const PointSnapshot<dim> &snapshot)
+  {
+    const auto        &p            = snapshot.points;
+    const unsigned int n_properties = PropertyLayout<dim>::n_properties;
+    unsigned int       n            = 0;
+    for (int i = 0; i < p.size(); ++i)
+      n += p.material[i] >= 0;
+    patches.clear();
+    patches.resize(n);
+    std::vector<double> values(n_properties);
+    unsigned int        k = 0;
+    for (int i = 0; i < p.size(); ++i)
+      {
+        if (p.material[i] < 0)
+          continue; // left the grid
+        auto &patch = patches[k];
+        for (int d = 0; d < dim; ++d)
+          patch.vertices[0][d] = p.position[d][i];
+        patch.patch_index = k;
+        patch.data.reinit(n_properties + 1, 1);
+        patch.data(0, 0) = snapshot.labels->id[i];
+        snapshot.properties(i, values.data());
+        for (unsigned int c = 0; c < n_properties; ++c)
+          patch.data(c + 1, 0) = values[c];
+        ++k;
+      }
+  }
+
+  template <int dim>
+  std::vector<std::string> PointDataOut<dim>::get_dataset_names() const
+  {
+    std::vector<std::string> names = {"id"};
+    for (const auto &name : PropertyLayout<dim>::names())
+      names.push_back(name);
+    return names;
+  }
+
+  // Consecutive vector components of one name form one range, as in Particles::DataOut.
+  template <int dim>
+  Ranges PointDataOut<dim>::get_nonscalar_data_ranges() const
+  {
+    using namespace dealii::DataComponentInterpretation;
+    const auto names = get_dataset_names();
+    std::vector<DataComponentInterpretation> kinds = {component_is_scalar};
+    for (const auto kind : PropertyLayout<dim>::interpretations())
+      kinds.push_back(kind);
+    Ranges ranges;
+    for (unsigned int i = 0; i < names.size();)
+      if (kinds[i] == component_is_part_of_vector)
+        {
+          unsigned int n = 1;
+          while (i + n < names.size() && kinds[i + n] == component_is_part_of_vector && names[i + n] == names[i])
+            ++n;
+          ranges.emplace_back(i, i + n - 1, names[i], component_is_part_of_vector);
+          i += n;
+        }
+      else
+        ++i;
+    return ranges;
+  }
+
   template <int dim>
   OutputWriter<dim>::OutputWriter(const Parameters &parameters, MPI_Comm communicator)
     : communicator(communicator)
+    , rank(dealii::Utilities::MPI::this_mpi_process(communicator))
+    , n_ranks(dealii::Utilities::MPI::n_mpi_processes(communicator))
     , output_directory(parameters.output_directory)
     , write_grid(parameters.write_grid_fields)
     , write_particles(parameters.write_particles)
     , write_table(parameters.write_particle_table)
+    , background(parameters.output_in_background)
   {
     if (output_directory.empty())
       output_directory = ".";
+    using Flags = dealii::DataOutBase::VtkFlags;
+    vtk_flags.compression_level = parameters.output_compression == "no compression"   ? Flags::no_compression :
+                                  parameters.output_compression == "best compression" ? Flags::best_compression :
+                                  parameters.output_compression == "default"          ? Flags::default_compression :
+                                                                                        Flags::best_speed;
     // Rank 0 creates the folder and the history; every rank learns whether that worked,
     // so that a bad Output/Directory stops all ranks with one message instead of a hang.
     std::string problem;
-    if (dealii::Utilities::MPI::this_mpi_process(communicator) == 0)
+    if (rank == 0)
       {
         std::error_code error;
         std::filesystem::create_directories(output_directory, error);
@@ -39,7 +227,7 @@ namespace mpm
       }
     problem = dealii::Utilities::MPI::broadcast(communicator, problem, 0);
     AssertThrow(problem.empty(), dealii::ExcMessage("Parameter 'Output/Directory': " + problem));
-    if (dealii::Utilities::MPI::this_mpi_process(communicator) == 0)
+    if (rank == 0)
       {
         history << "time,dt,step,kinetic_energy,work_of_gravity,total_mass";
         for (int d = 0; d < dim; ++d)
@@ -55,12 +243,35 @@ namespace mpm
   }
 
   template <int dim>
-  void OutputWriter<dim>::write_fields(const double time, BackgroundGrid<dim> &grid, const MaterialPoints<dim> &points)
+  OutputWriter<dim>::~OutputWriter()
   {
-    const bool root = dealii::Utilities::MPI::this_mpi_process(communicator) == 0;
+    if (in_flight.valid())
+      in_flight.wait();
+  }
+
+  template <int dim>
+  void OutputWriter<dim>::finish()
+  {
+    if (in_flight.valid())
+      in_flight.get(); // rethrows
+  }
+
+  template <int dim>
+  PointSnapshot<dim> &OutputWriter<dim>::next_snapshot()
+  {
+    finish();
+    return snapshot;
+  }
+
+  template <int dim>
+  void OutputWriter<dim>::write_fields(const double time, BackgroundGrid<dim> &grid)
+  {
+    finish();
+    // Grid patches now: they read the DoFHandler and the nodal vectors.
+    std::shared_ptr<OwnedPatches<dim, dim>> grid_patches;
     if (write_grid)
       {
-        dealii::DataOut<dim> out;
+        GridDataOut<dim> out;
         out.attach_dof_handler(grid.dof_handler);
         grid.mass.update_ghost_values();
         out.add_data_vector(grid.mass, "nodal_mass");
@@ -71,67 +282,40 @@ namespace mpm
             out.add_data_vector(grid.velocity[d], names[d]);
           }
         dealii::Vector<float> subdomain(grid.triangulation.n_active_cells());
-        subdomain = dealii::Utilities::MPI::this_mpi_process(communicator);
+        subdomain = rank;
         out.add_data_vector(subdomain, "subdomain");
         out.build_patches();
-        const std::string name = out.write_vtu_with_pvtu_record(output_directory + "/", "grid", counter, communicator, 5);
-        grid_records.emplace_back(time, name);
-        if (root)
-          {
-            std::ofstream pvd(output_directory + "/grid.pvd");
-            dealii::DataOutBase::write_pvd_record(pvd, grid_records);
-          }
+        grid_patches = out.take();
+        grid_patches->set_flags(vtk_flags);
+        grid_records.emplace_back(time, record_name("grid", counter));
       }
     if (write_particles)
-      {
-        dealii::Particles::DataOut<dim> out;
-        out.build_patches(points.handler, PropertyLayout<dim>::names(), PropertyLayout<dim>::interpretations());
-        const std::string name =
-          out.write_vtu_with_pvtu_record(output_directory + "/", "particles", counter, communicator, 5);
-        particle_records.emplace_back(time, name);
-        if (root)
-          {
-            std::ofstream pvd(output_directory + "/particles.pvd");
-            dealii::DataOutBase::write_pvd_record(pvd, particle_records);
-          }
-      }
-    if (write_table)
-      {
-        const unsigned int rank = dealii::Utilities::MPI::this_mpi_process(communicator);
-        std::ostringstream name;
-        name << output_directory << "/particle_table_" << std::setw(5) << std::setfill('0') << counter << '.'
-             << rank << ".csv";
-        std::ofstream table(name.str());
-        AssertThrow(table, dealii::ExcMessage("Parameter 'Output/Directory': cannot write '" + name.str() + "'."));
-        const auto names = PropertyLayout<dim>::names();
-        table << "id";
-        for (int d = 0; d < dim; ++d)
-          table << ",position_" << "xyz"[d];
-        std::vector<unsigned int> seen(names.size(), 0);
-        for (unsigned int k = 0; k < names.size(); ++k)
-          {
-            // Vector properties repeat their name: number their components.
-            unsigned int repeats = 0;
-            for (unsigned int j = 0; j < names.size(); ++j)
-              repeats += names[j] == names[k];
-            table << ',' << names[k];
-            if (repeats > 1)
-              table << '_' << "xyz"[seen[k]];
-            for (unsigned int j = k + 1; j < names.size(); ++j)
-              if (names[j] == names[k])
-                seen[j] = seen[k] + 1;
-          }
-        table << '\n' << std::setprecision(17);
-        for (const auto &particle : points.handler)
-          {
-            table << particle.get_id();
-            for (int d = 0; d < dim; ++d)
-              table << ',' << particle.get_location()[d];
-            for (const double value : particle.get_properties())
-              table << ',' << value;
-            table << '\n';
-          }
-      }
+      particle_records.emplace_back(time, record_name("particles", counter));
+
+    // The rest reads only what it owns (the snapshot is not touched until finish()).
+    auto task = [this, grid_patches, counter = counter, grid_records = grid_records,
+                 particle_records = particle_records]() {
+      if (grid_patches)
+        write_piece(*grid_patches, output_directory, "grid", counter, rank, n_ranks, grid_records);
+      if (write_particles)
+        {
+          PointDataOut<dim> out;
+          out.set_flags(vtk_flags);
+          out.build_patches(snapshot);
+          write_piece(out, output_directory, "particles", counter, rank, n_ranks, particle_records);
+        }
+      if (write_table)
+        {
+          std::ostringstream name;
+          name << output_directory << "/particle_table_" << std::setw(5) << std::setfill('0') << counter << '.'
+               << rank << ".csv";
+          write_point_table(snapshot, name.str());
+        }
+    };
+    if (background)
+      in_flight = std::async(std::launch::async, task);
+    else
+      task();
     ++counter;
   }
 

@@ -208,6 +208,15 @@ namespace mpm
     prm.declare_entry("Write particle table", "false", Patterns::Bool(),
                       "Also write particle_table_NNNNN.R.csv (one per output and rank R): id, position and every "
                       "property in full precision, for comparisons the single-precision .vtu files cannot resolve.");
+    prm.declare_entry("Compression", "best speed",
+                      Patterns::Selection("best speed|default|best compression|no compression"),
+                      "zlib compression level of the .vtu files (deal.II's VtkFlags::compression_level). best "
+                      "speed: about as small as the others for MPM data, several times faster to write than "
+                      "best compression (doc/performance.md, Output).");
+    prm.declare_entry("Write in background", "true", Patterns::Bool(),
+                      "Build, compress and write the output files on a background thread while the steps go on; "
+                      "the points are copied first (one snapshot), so the steps cannot change what is written. "
+                      "false: the run waits for each output to be written.");
     prm.leave_subsection();
 
     prm.enter_subsection("Parallel");
@@ -431,6 +440,8 @@ namespace mpm
     history_every     = prm.get_integer("History every n steps");
     progress_interval = prm.get_double("Progress interval");
     write_particle_table = prm.get_bool("Write particle table");
+    output_compression   = prm.get("Compression");
+    output_in_background = prm.get_bool("Write in background");
     prm.leave_subsection();
 
     prm.enter_subsection("Parallel");

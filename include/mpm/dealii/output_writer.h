@@ -1,29 +1,71 @@
 // Field output (grid nodes and material points as .vtu/.pvtu with .pvd time series)
 // and the time history (history.csv), written once in parallel.
+//
+// The particle files are written from a snapshot of the engine's arrays (Engine::snapshot),
+// not from the ParticleHandler: no hand-over, no re-sort per output. Their content is what
+// deal.II's Particles::DataOut writes for the handler (same names, components, values;
+// tests/dealii/test_output_paths.cc asserts it). The grid's patches are built when the output
+// is asked for; compressing and writing the files (and building the particle patches from
+// the snapshot, which is a copy) can run on a background thread while the steps go on
+// (Output/Write in background).
 #pragma once
 
 #include <mpm/core/diagnostics.h>
 #include <mpm/dealii/background_grid.h>
 #include <mpm/dealii/material_points.h>
 
+#include <deal.II/base/data_out_base.h>
+
 #include <fstream>
+#include <future>
 #include <string>
 #include <utility>
 #include <vector>
 
 namespace mpm
 {
+  // deal.II's Particles::DataOut layout from a snapshot: one patch per point (points that
+  // left the grid skipped), data "id" then every property of PropertyLayout by name, with
+  // the same vector ranges.
+  template <int dim>
+  class PointDataOut : public dealii::DataOutInterface<0, dim>
+  {
+  public:
+    void build_patches(const PointSnapshot<dim> &snapshot);
+
+  protected:
+    const std::vector<dealii::DataOutBase::Patch<0, dim>> &get_patches() const override { return patches; }
+    std::vector<std::string>                               get_dataset_names() const override;
+    std::vector<std::tuple<unsigned int, unsigned int, std::string,
+                           dealii::DataComponentInterpretation::DataComponentInterpretation>>
+    get_nonscalar_data_ranges() const override;
+
+  private:
+    std::vector<dealii::DataOutBase::Patch<0, dim>> patches;
+  };
+
   template <int dim>
   class OutputWriter
   {
   public:
     OutputWriter(const Parameters &parameters, MPI_Comm communicator);
+    // Waits for a write in flight; an error there is reported by finish(), not here.
+    ~OutputWriter();
 
-    // Writes grid and particle files for time t and updates the .pvd records (rank 0
-    // writes the .pvtu and .pvd records, every rank its own .vtu piece). With Output/Write
-    // particle table, also particle_table_NNNNN.R.csv per rank R: id, position and every
-    // property in full precision (the .vtu files hold single precision).
-    void write_fields(double time, BackgroundGrid<dim> &grid, const MaterialPoints<dim> &points);
+    // The snapshot the next write_fields() writes: fill it (Engine::snapshot) right
+    // before. Waits for the write in flight that still reads it.
+    PointSnapshot<dim> &next_snapshot();
+
+    // Writes grid and particle files for time t (rank 0 writes the .pvtu and .pvd records,
+    // every rank its own .vtu piece) from the grid's nodal vectors and next_snapshot().
+    // With Output/Write particle table, also particle_table_NNNNN.R.csv per rank R: id,
+    // position and every property in full precision (the .vtu files hold single
+    // precision). The grid's patches are built before returning; the rest may still be
+    // running on the background thread when it returns.
+    void write_fields(double time, BackgroundGrid<dim> &grid);
+
+    // Waits for the write in flight and rethrows its error, if any.
+    void finish();
 
     struct HistoryRow
     {
@@ -39,11 +81,15 @@ namespace mpm
     const std::string &directory() const { return output_directory; }
 
   private:
-    MPI_Comm    communicator;
-    std::string output_directory;
-    bool        write_grid, write_particles, write_table;
-    unsigned int counter = 0;
+    MPI_Comm                          communicator;
+    unsigned int                      rank, n_ranks;
+    std::string                       output_directory;
+    bool                              write_grid, write_particles, write_table, background;
+    dealii::DataOutBase::VtkFlags     vtk_flags;
+    unsigned int                      counter = 0;
     std::vector<std::pair<double, std::string>> grid_records, particle_records;
-    std::ofstream history;
+    std::ofstream                     history;
+    PointSnapshot<dim>                snapshot;
+    std::future<void>                 in_flight;
   };
 } // namespace mpm

@@ -79,6 +79,8 @@ namespace mpm
     unsigned int history_every;
     double       progress_interval;
     bool         write_particle_table;
+    std::string  output_compression;   // zlib level of the .vtu files: "best speed", ...
+    bool         output_in_background; // compress and write files on a background thread
 
     // Parallel runs (doc/performance.md, MPI)
     double resort_distance;        // re-sort at this fraction of the safe distance outside a home cell
