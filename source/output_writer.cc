@@ -5,7 +5,9 @@
 #include <deal.II/base/utilities.h>
 #include <deal.II/numerics/data_out.h>
 
+#include <chrono>
 #include <filesystem>
+#include <functional>
 #include <iomanip>
 #include <memory>
 #include <sstream>
@@ -17,40 +19,6 @@ namespace mpm
     using Ranges = std::vector<std::tuple<unsigned int, unsigned int, std::string,
                                           dealii::DataComponentInterpretation::DataComponentInterpretation>>;
 
-    // Patches, names and vector ranges owned by value, so that a background thread can
-    // write them while the triangulation, the DoFHandler and the vectors move on.
-    template <int patch_dim, int spacedim>
-    class OwnedPatches : public dealii::DataOutInterface<patch_dim, spacedim>
-    {
-    public:
-      std::vector<dealii::DataOutBase::Patch<patch_dim, spacedim>> patches;
-      std::vector<std::string>                                     names;
-      Ranges                                                       ranges;
-
-    protected:
-      const std::vector<dealii::DataOutBase::Patch<patch_dim, spacedim>> &get_patches() const override
-      {
-        return patches;
-      }
-      std::vector<std::string> get_dataset_names() const override { return names; }
-      Ranges                   get_nonscalar_data_ranges() const override { return ranges; }
-    };
-
-    // DataOut whose built patches can be taken away (DataOut keeps pointers to the
-    // DoFHandler and the vectors, which the steps change).
-    template <int dim>
-    class GridDataOut : public dealii::DataOut<dim>
-    {
-    public:
-      std::unique_ptr<OwnedPatches<dim, dim>> take()
-      {
-        auto owned     = std::make_unique<OwnedPatches<dim, dim>>();
-        owned->names   = this->get_dataset_names();
-        owned->ranges  = this->get_nonscalar_data_ranges();
-        owned->patches = std::move(this->patches);
-        return owned;
-      }
-    };
 
     // Piece and record names as DataOutInterface::write_vtu_with_pvtu_record writes them
     // (one piece per rank): name_CCCCC.R.vtu and name_CCCCC.pvtu.
@@ -245,15 +213,21 @@ namespace mpm
   template <int dim>
   OutputWriter<dim>::~OutputWriter()
   {
-    if (in_flight.valid())
-      in_flight.wait();
+    for (auto &task : in_flight)
+      task.wait();
   }
 
   template <int dim>
   void OutputWriter<dim>::finish()
   {
-    if (in_flight.valid())
-      in_flight.get(); // rethrows
+    std::vector<std::future<void>> tasks;
+    tasks.swap(in_flight);
+    const auto start = std::chrono::steady_clock::now();
+    for (auto &task : tasks)
+      task.wait();
+    waited += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    for (auto &task : tasks)
+      task.get(); // rethrows the first error
   }
 
   template <int dim>
@@ -267,42 +241,40 @@ namespace mpm
   void OutputWriter<dim>::write_fields(const double time, BackgroundGrid<dim> &grid)
   {
     finish();
-    // Grid patches now: they read the DoFHandler and the nodal vectors.
-    std::shared_ptr<OwnedPatches<dim, dim>> grid_patches;
+    // What the background tasks read is copied now. DataOut::add_data_vector makes its own
+    // ghosted copy of each vector (MPI: here, on this thread); build_patches then reads
+    // those copies and the DoFHandler as it is (it changes only in a repartition, which
+    // calls finish() first) and does no communication.
+    std::shared_ptr<dealii::DataOut<dim>> grid_out;
     if (write_grid)
       {
-        GridDataOut<dim> out;
-        out.attach_dof_handler(grid.dof_handler);
-        grid.mass.update_ghost_values();
-        out.add_data_vector(grid.mass, "nodal_mass");
+        grid_out = std::make_shared<dealii::DataOut<dim>>();
+        grid_out->attach_dof_handler(grid.dof_handler);
+        grid_out->add_data_vector(grid.mass, "nodal_mass");
         const char *names[3] = {"nodal_velocity_x", "nodal_velocity_y", "nodal_velocity_z"};
         for (int d = 0; d < dim; ++d)
-          {
-            grid.velocity[d].update_ghost_values();
-            out.add_data_vector(grid.velocity[d], names[d]);
-          }
+          grid_out->add_data_vector(grid.velocity[d], names[d]);
         dealii::Vector<float> subdomain(grid.triangulation.n_active_cells());
         subdomain = rank;
-        out.add_data_vector(subdomain, "subdomain");
-        out.build_patches();
-        grid_patches = out.take();
-        grid_patches->set_flags(vtk_flags);
+        grid_out->add_data_vector(subdomain, "subdomain");
         grid_records.emplace_back(time, record_name("grid", counter));
       }
     if (write_particles)
       particle_records.emplace_back(time, record_name("particles", counter));
 
-    // The rest reads only what it owns (the snapshot is not touched until finish()).
-    auto task = [this, grid_patches, counter = counter, grid_records = grid_records,
-                 particle_records = particle_records]() {
-      if (grid_patches)
-        write_piece(*grid_patches, output_directory, "grid", counter, rank, n_ranks, grid_records);
+    // Two tasks, each reading only what it owns (the snapshot is not touched until finish()).
+    auto grid_task = [this, grid_out, counter = counter, records = grid_records]() {
+      grid_out->build_patches();
+      grid_out->set_flags(vtk_flags);
+      write_piece(*grid_out, output_directory, "grid", counter, rank, n_ranks, records);
+    };
+    auto point_task = [this, counter = counter, records = particle_records]() {
       if (write_particles)
         {
           PointDataOut<dim> out;
           out.set_flags(vtk_flags);
           out.build_patches(snapshot);
-          write_piece(out, output_directory, "particles", counter, rank, n_ranks, particle_records);
+          write_piece(out, output_directory, "particles", counter, rank, n_ranks, records);
         }
       if (write_table)
         {
@@ -312,10 +284,25 @@ namespace mpm
           write_point_table(snapshot, name.str());
         }
     };
-    if (background)
-      in_flight = std::async(std::launch::async, task);
-    else
-      task();
+    std::vector<std::function<void()>> tasks;
+    if (write_grid)
+      tasks.emplace_back(grid_task);
+    if (write_particles || write_table)
+      tasks.emplace_back(point_task);
+    for (auto &task : tasks)
+      {
+        auto timed = [this, task]() {
+          const auto start = std::chrono::steady_clock::now();
+          task();
+          task_nanoseconds += std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                std::chrono::steady_clock::now() - start)
+                                .count();
+        };
+        if (background)
+          in_flight.push_back(std::async(std::launch::async, timed));
+        else
+          timed();
+      }
     ++counter;
   }
 

@@ -83,6 +83,7 @@ namespace mpm
     bool plastic = !(parameters.plasticity_start_time > 0);
     for (auto &m : materials)
       m.plasticity_enabled = plastic;
+    OutputWriter<dim> output(parameters, communicator);
     // MPI: points re-sorted into cells and ranks, grid repartitioned by work.
     const bool   parallel  = dealii::Utilities::MPI::n_mpi_processes(communicator) > 1;
     // Pressure averaging in parallel: a point's cell at the end of a step must be an owned
@@ -106,6 +107,7 @@ namespace mpm
           before <= balanced + 0.5 * (parameters.load_balance_threshold - 1))
         return false;
       dealii::TimerOutput::Scope scope(timer, "repartition");
+      output.finish(); // a grid output in flight reads the DoFHandler
       points.repartition();
       ++n_repartitions;
       balanced = points.imbalance();
@@ -116,7 +118,6 @@ namespace mpm
     balance();
     auto engine = make_engine<dim>(parameters.backend, grid, materials, parameters.shape_function);
     engine->load(points);
-    OutputWriter<dim> output(parameters, communicator);
     timer.leave_subsection();
 
     pcout << "dealii-mpm: " << dim << "D, " << grid.triangulation.n_global_active_cells() << " cells, "
@@ -292,6 +293,9 @@ namespace mpm
               << static_cast<long>(max(ghosts, communicator)) << " at most on one rank; exchange " << bytes
               << " bytes per step (" << arrays << " nodal arrays, each ghost value sent to its owner and back)\n";
       }
+    pcout << "  output: " << output.n_outputs() << " outputs, " << output.task_seconds()
+          << " s building and writing files (rank 0, " << (parameters.output_in_background ? "background threads" : "in line")
+          << "), " << output.waited_seconds() << " s of it waited for\n";
     pcout
           << "  results: " << output.directory() << "/particles.pvd, " << output.directory()
           << "/grid.pvd, " << output.directory() << "/history.csv" << std::endl;

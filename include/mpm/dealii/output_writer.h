@@ -4,10 +4,11 @@
 // The particle files are written from a snapshot of the engine's arrays (Engine::snapshot),
 // not from the ParticleHandler: no hand-over, no re-sort per output. Their content is what
 // deal.II's Particles::DataOut writes for the handler (same names, components, values;
-// tests/dealii/test_output_paths.cc asserts it). The grid's patches are built when the output
-// is asked for; compressing and writing the files (and building the particle patches from
-// the snapshot, which is a copy) can run on a background thread while the steps go on
-// (Output/Write in background).
+// tests/dealii/test_output_paths.cc asserts it). What the files show is copied when the output
+// is asked for (the snapshot, the nodal vectors); building the patches, compressing and
+// writing can then run on two background threads (grid, particles) while the steps go on
+// (Output/Write in background). The DoFHandler is read there as it is: a repartition must
+// call finish() first.
 #pragma once
 
 #include <mpm/core/diagnostics.h>
@@ -16,6 +17,7 @@
 
 #include <deal.II/base/data_out_base.h>
 
+#include <atomic>
 #include <fstream>
 #include <future>
 #include <string>
@@ -60,11 +62,12 @@ namespace mpm
     // every rank its own .vtu piece) from the grid's nodal vectors and next_snapshot().
     // With Output/Write particle table, also particle_table_NNNNN.R.csv per rank R: id,
     // position and every property in full precision (the .vtu files hold single
-    // precision). The grid's patches are built before returning; the rest may still be
-    // running on the background thread when it returns.
+    // precision). Copies the nodal vectors (with their ghosts: MPI) before returning; the
+    // rest may still be running on background threads when it returns.
     void write_fields(double time, BackgroundGrid<dim> &grid);
 
-    // Waits for the write in flight and rethrows its error, if any.
+    // Waits for the writes in flight and rethrows their error, if any. Call it before the
+    // triangulation or the DoFHandler change (repartition).
     void finish();
 
     struct HistoryRow
@@ -80,6 +83,13 @@ namespace mpm
 
     const std::string &directory() const { return output_directory; }
 
+    // Outputs written so far, seconds spent in the write tasks (building patches,
+    // compressing, writing; summed over tasks, on background threads where they ran
+    // there) and seconds the run waited for them in finish().
+    unsigned int n_outputs() const { return counter; }
+    double       task_seconds() const { return 1e-9 * task_nanoseconds; }
+    double       waited_seconds() const { return waited; }
+
   private:
     MPI_Comm                          communicator;
     unsigned int                      rank, n_ranks;
@@ -90,6 +100,8 @@ namespace mpm
     std::vector<std::pair<double, std::string>> grid_records, particle_records;
     std::ofstream                     history;
     PointSnapshot<dim>                snapshot;
-    std::future<void>                 in_flight;
+    std::vector<std::future<void>>    in_flight; // grid and particle tasks
+    std::atomic<long long>            task_nanoseconds{0};
+    double                            waited = 0;
   };
 } // namespace mpm
