@@ -21,38 +21,107 @@ namespace mpm
 
 
     // Piece and record names as DataOutInterface::write_vtu_with_pvtu_record writes them
-    // (one piece per rank): name_CCCCC.R.vtu and name_CCCCC.pvtu.
-    std::string piece_name(const std::string &name, const unsigned int counter, const unsigned int rank,
-                           const unsigned int n_ranks)
+    // (one piece per rank: name_CCCCC.R.vtu and name_CCCCC.pvtu), with K pieces per rank
+    // numbered R K + k.
+    std::string piece_name(const std::string &name, const unsigned int counter, const unsigned int piece,
+                           const unsigned int n_pieces)
     {
       return name + "_" + dealii::Utilities::int_to_string(counter, 5) + "." +
-             dealii::Utilities::int_to_string(rank, dealii::Utilities::needed_digits(n_ranks - 1)) + ".vtu";
+             dealii::Utilities::int_to_string(piece, dealii::Utilities::needed_digits(n_pieces - 1)) + ".vtu";
     }
     std::string record_name(const std::string &name, const unsigned int counter)
     {
       return name + "_" + dealii::Utilities::int_to_string(counter, 5) + ".pvtu";
     }
 
-    // One rank's .vtu piece; on rank 0 also the .pvtu record and the .pvd time series.
+    // One .vtu piece (number piece of n_pieces); with write_records also the .pvtu record
+    // of all pieces and the .pvd time series (rank 0, once per output).
     template <int patch_dim, int spacedim>
     void write_piece(const dealii::DataOutInterface<patch_dim, spacedim> &out, const std::string &directory,
-                     const std::string &name, const unsigned int counter, const unsigned int rank,
-                     const unsigned int n_ranks, const std::vector<std::pair<double, std::string>> &records)
+                     const std::string &name, const unsigned int counter, const unsigned int piece,
+                     const unsigned int n_pieces, const bool write_records,
+                     const std::vector<std::pair<double, std::string>> &records)
     {
-      const std::string piece = directory + "/" + piece_name(name, counter, rank, n_ranks);
-      std::ofstream     file(piece);
-      AssertThrow(file, dealii::ExcMessage("Parameter 'Output/Directory': cannot write '" + piece + "'."));
+      const std::string file_name = directory + "/" + piece_name(name, counter, piece, n_pieces);
+      std::ofstream     file(file_name);
+      AssertThrow(file, dealii::ExcMessage("Parameter 'Output/Directory': cannot write '" + file_name + "'."));
       out.write_vtu(file);
-      AssertThrow(file, dealii::ExcMessage("Parameter 'Output/Directory': writing '" + piece + "' failed."));
-      if (rank != 0)
+      AssertThrow(file, dealii::ExcMessage("Parameter 'Output/Directory': writing '" + file_name + "' failed."));
+      if (!write_records)
         return;
       std::vector<std::string> pieces;
-      for (unsigned int r = 0; r < n_ranks; ++r)
-        pieces.push_back(piece_name(name, counter, r, n_ranks));
+      for (unsigned int r = 0; r < n_pieces; ++r)
+        pieces.push_back(piece_name(name, counter, r, n_pieces));
       std::ofstream pvtu(directory + "/" + record_name(name, counter));
       out.write_pvtu_record(pvtu, pieces);
       std::ofstream pvd(directory + "/" + name + ".pvd");
       dealii::DataOutBase::write_pvd_record(pvd, records);
+    }
+
+    // Patches, names and vector ranges owned by value: one piece of a DataOut's patches.
+    template <int dim>
+    class GridPiece : public dealii::DataOutInterface<dim, dim>
+    {
+    public:
+      std::vector<dealii::DataOutBase::Patch<dim, dim>> patches;
+      std::vector<std::string>                          names;
+      Ranges                                            ranges;
+
+    protected:
+      const std::vector<dealii::DataOutBase::Patch<dim, dim>> &get_patches() const override { return patches; }
+      std::vector<std::string> get_dataset_names() const override { return names; }
+      Ranges                   get_nonscalar_data_ranges() const override { return ranges; }
+    };
+
+    // DataOut whose built patches can be split into pieces (each written on its own thread).
+    template <int dim>
+    class GridDataOut : public dealii::DataOut<dim>
+    {
+    public:
+      std::vector<GridPiece<dim>> split(const unsigned int n_pieces)
+      {
+        std::vector<GridPiece<dim>> pieces(n_pieces);
+        const std::size_t           n = this->patches.size();
+        for (unsigned int k = 0; k < n_pieces; ++k)
+          {
+            pieces[k].names  = this->get_dataset_names();
+            pieces[k].ranges = this->get_nonscalar_data_ranges();
+            pieces[k].patches.assign(std::make_move_iterator(this->patches.begin() + n * k / n_pieces),
+                                     std::make_move_iterator(this->patches.begin() + n * (k + 1) / n_pieces));
+          }
+        this->patches.clear();
+        return pieces;
+      }
+    };
+
+    // Runs the tasks on their own threads and waits for all; rethrows the first error.
+    void run_all(std::vector<std::function<void()>> &tasks)
+    {
+      std::vector<std::future<void>> running;
+      for (unsigned int k = 1; k < tasks.size(); ++k)
+        running.push_back(std::async(std::launch::async, tasks[k]));
+      std::exception_ptr error;
+      try
+        {
+          if (!tasks.empty())
+            tasks[0]();
+        }
+      catch (...)
+        {
+          error = std::current_exception();
+        }
+      for (auto &task : running)
+        try
+          {
+            task.get();
+          }
+        catch (...)
+          {
+            if (!error)
+              error = std::current_exception();
+          }
+      if (error)
+        std::rethrow_exception(error);
     }
 
     // Full-precision table of one rank's points: id, position, every property.
@@ -98,18 +167,19 @@ namespace mpm
   } // namespace
 
   template <int dim>
-  void PointDataOut<dim>::build_patches(const PointSnapshot<dim> &snapshot)
+  void PointDataOut<dim>::build_patches(const PointSnapshot<dim> &snapshot, const int begin, const int end)
   {
     const auto        &p            = snapshot.points;
     const unsigned int n_properties = PropertyLayout<dim>::n_properties;
+    const int          last         = end < 0 ? p.size() : end;
     unsigned int       n            = 0;
-    for (int i = 0; i < p.size(); ++i)
+    for (int i = begin; i < last; ++i)
       n += p.material[i] >= 0;
     patches.clear();
     patches.resize(n);
     std::vector<double> values(n_properties);
     unsigned int        k = 0;
-    for (int i = 0; i < p.size(); ++i)
+    for (int i = begin; i < last; ++i)
       {
         if (p.material[i] < 0)
           continue; // left the grid
@@ -169,6 +239,7 @@ namespace mpm
     , write_particles(parameters.write_particles)
     , write_table(parameters.write_particle_table)
     , background(parameters.output_in_background)
+    , pieces_per_rank(parameters.output_files_per_rank)
   {
     if (output_directory.empty())
       output_directory = ".";
@@ -245,10 +316,10 @@ namespace mpm
     // ghosted copy of each vector (MPI: here, on this thread); build_patches then reads
     // those copies and the DoFHandler as it is (it changes only in a repartition, which
     // calls finish() first) and does no communication.
-    std::shared_ptr<dealii::DataOut<dim>> grid_out;
+    std::shared_ptr<GridDataOut<dim>> grid_out;
     if (write_grid)
       {
-        grid_out = std::make_shared<dealii::DataOut<dim>>();
+        grid_out = std::make_shared<GridDataOut<dim>>();
         grid_out->attach_dof_handler(grid.dof_handler);
         grid_out->add_data_vector(grid.mass, "nodal_mass");
         const char *names[3] = {"nodal_velocity_x", "nodal_velocity_y", "nodal_velocity_z"};
@@ -262,19 +333,35 @@ namespace mpm
     if (write_particles)
       particle_records.emplace_back(time, record_name("particles", counter));
 
-    // Two tasks, each reading only what it owns (the snapshot is not touched until finish()).
-    auto grid_task = [this, grid_out, counter = counter, records = grid_records]() {
+    // Two tasks, each reading only what it owns (the snapshot is not touched until finish());
+    // each writes its Output/Files per rank pieces on as many threads.
+    const unsigned int K = pieces_per_rank;
+    auto grid_task = [this, grid_out, K, counter = counter, records = grid_records]() {
       grid_out->build_patches();
-      grid_out->set_flags(vtk_flags);
-      write_piece(*grid_out, output_directory, "grid", counter, rank, n_ranks, records);
+      auto                               pieces = grid_out->split(K);
+      std::vector<std::function<void()>> writes;
+      for (unsigned int k = 0; k < K; ++k)
+        writes.emplace_back([&, k]() {
+          pieces[k].set_flags(vtk_flags);
+          write_piece(pieces[k], output_directory, "grid", counter, rank * K + k, n_ranks * K, rank == 0 && k == 0,
+                      records);
+        });
+      run_all(writes);
     };
-    auto point_task = [this, counter = counter, records = particle_records]() {
+    auto point_task = [this, K, counter = counter, records = particle_records]() {
       if (write_particles)
         {
-          PointDataOut<dim> out;
-          out.set_flags(vtk_flags);
-          out.build_patches(snapshot);
-          write_piece(out, output_directory, "particles", counter, rank, n_ranks, records);
+          std::vector<std::function<void()>> writes;
+          const int                          n = snapshot.points.size();
+          for (unsigned int k = 0; k < K; ++k)
+            writes.emplace_back([&, k]() {
+              PointDataOut<dim> out;
+              out.set_flags(vtk_flags);
+              out.build_patches(snapshot, int(long(n) * k / K), int(long(n) * (k + 1) / K));
+              write_piece(out, output_directory, "particles", counter, rank * K + k, n_ranks * K,
+                          rank == 0 && k == 0, records);
+            });
+          run_all(writes);
         }
       if (write_table)
         {

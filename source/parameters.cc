@@ -217,6 +217,10 @@ namespace mpm
                       "Build, compress and write the output files on a background thread while the steps go on; "
                       "the points are copied first (one snapshot), so the steps cannot change what is written. "
                       "false: the run waits for each output to be written.");
+    prm.declare_entry("Files per rank", "1", Patterns::Integer(1, 256),
+                      "Each rank writes its grid cells and its points as this many .vtu pieces per output (the "
+                      ".pvtu record lists them all), built, compressed and written on as many threads: more than "
+                      "1 speeds up the output of large scenes on many cores.");
     prm.leave_subsection();
 
     prm.enter_subsection("Parallel");
@@ -442,6 +446,7 @@ namespace mpm
     write_particle_table = prm.get_bool("Write particle table");
     output_compression   = prm.get("Compression");
     output_in_background = prm.get_bool("Write in background");
+    output_files_per_rank = prm.get_integer("Files per rank");
     prm.leave_subsection();
 
     prm.enter_subsection("Parallel");

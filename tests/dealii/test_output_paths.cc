@@ -5,7 +5,9 @@
 //    or missing property in PointSnapshot::properties changes the file);
 //  - a point that left the grid (material < 0 in the engine) is missing from the patches,
 //    as it is from the handler after the hand-over removes it (same patches by id);
-//  - the .pvtu records are the same.
+//  - the .pvtu records are the same;
+//  - pieces of consecutive point ranges (Output/Files per rank) add up to the whole, and an
+//    empty piece is a valid file.
 // Runs on any number of MPI ranks (each rank compares its own piece).
 #include <mpm/dealii/material_points.h>
 #include <mpm/dealii/output_writer.h>
@@ -122,6 +124,27 @@ namespace
     mpm_test::check(a == b, dim == 2 ? "2D: same .vtu from the handler and from the snapshot" :
                                        "3D: same .vtu from the handler and from the snapshot");
     mpm_test::check(pvtu(from_handler) == pvtu(from_snapshot), "same .pvtu record");
+
+    // Pieces (Output/Files per rank): consecutive ranges of points give the same patches in
+    // the same order; an empty piece is a valid file without points.
+    {
+      const int                  n = snapshot.points.size();
+      Exposed<PointDataOut<dim>> whole, first, second, empty;
+      whole.build_patches(snapshot);
+      first.build_patches(snapshot, 0, n / 3);
+      second.build_patches(snapshot, n / 3, n);
+      empty.build_patches(snapshot, n, n);
+      bool same = first.get_patches().size() + second.get_patches().size() == whole.get_patches().size();
+      for (unsigned int i = 0; same && i < whole.get_patches().size(); ++i)
+        {
+          const auto &piece = i < first.get_patches().size() ? first.get_patches()[i] :
+                                                               second.get_patches()[i - first.get_patches().size()];
+          same = piece.vertices[0] == whole.get_patches()[i].vertices[0] && piece.data == whole.get_patches()[i].data;
+        }
+      mpm_test::check(same, "two pieces hold the points of the whole, in order");
+      const std::string file = vtu(empty);
+      mpm_test::check(file.find("NumberOfPoints=\"0\"") != std::string::npos, "an empty piece is a file without points");
+    }
 
     // A point that left the grid: marked in the engine's arrays, removed from the handler
     // (which reorders the points of that cell): the same patches, matched by id.

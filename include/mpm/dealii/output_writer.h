@@ -33,7 +33,8 @@ namespace mpm
   class PointDataOut : public dealii::DataOutInterface<0, dim>
   {
   public:
-    void build_patches(const PointSnapshot<dim> &snapshot);
+    // Patches of the snapshot's points begin .. end - 1 (end < 0: to the last point).
+    void build_patches(const PointSnapshot<dim> &snapshot, int begin = 0, int end = -1);
 
   protected:
     const std::vector<dealii::DataOutBase::Patch<0, dim>> &get_patches() const override { return patches; }
@@ -59,7 +60,8 @@ namespace mpm
     PointSnapshot<dim> &next_snapshot();
 
     // Writes grid and particle files for time t (rank 0 writes the .pvtu and .pvd records,
-    // every rank its own .vtu piece) from the grid's nodal vectors and next_snapshot().
+    // every rank its own .vtu pieces: Output/Files per rank, written on as many threads)
+    // from the grid's nodal vectors and next_snapshot().
     // With Output/Write particle table, also particle_table_NNNNN.R.csv per rank R: id,
     // position and every property in full precision (the .vtu files hold single
     // precision). Copies the nodal vectors (with their ghosts: MPI) before returning; the
@@ -95,6 +97,7 @@ namespace mpm
     unsigned int                      rank, n_ranks;
     std::string                       output_directory;
     bool                              write_grid, write_particles, write_table, background;
+    unsigned int                      pieces_per_rank; // .vtu files per rank and output
     dealii::DataOutBase::VtkFlags     vtk_flags;
     unsigned int                      counter = 0;
     std::vector<std::pair<double, std::string>> grid_records, particle_records;
