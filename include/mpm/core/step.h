@@ -372,12 +372,6 @@ namespace mpm
       });
     }
 
-    // Cell pressure averaging (against volumetric locking, as in ep2-3De): every point
-    // of a lattice cell gets the volume-weighted mean pressure of the cell,
-    //   p_c = sum_p V_p p_p / sum_p V_p,   sigma_p <- s_p - p_c I   (s_p deviatoric part kept),
-    // with p = -tr(sigma)/3 (plane strain: sigma_zz included). Two passes through the
-    // backend: scatter V_p and V_p p_p into per-cell sums, then gather p_c back.
-    // The averaged stress is not returned to the yield surface again (ep2-3De neither).
     // exchange.sum_cells if the exchange has one; exchanges for one rank only (the CUDA
     // engine's nodal adapter) may have none.
     template <typename Exchange, typename Real>
@@ -390,6 +384,13 @@ namespace mpm
     void sum_cells(const Exchange &, Real *const *, const int, long)
     {}
 
+    // Cell pressure averaging (against volumetric locking, as in ep2-3De): every point
+    // of a lattice cell gets the volume-weighted mean pressure of the cell,
+    //   p_c = sum_p V_p p_p / sum_p V_p,   sigma_p <- s_p - p_c I   (s_p deviatoric part kept),
+    // with p = -tr(sigma)/3 (plane strain: sigma_zz included). Two passes through the
+    // backend: scatter V_p and V_p p_p into per-cell sums, then gather p_c back.
+    // The averaged stress is not returned to the yield surface again (ep2-3De neither).
+    // On several ranks, exchange.sum_cells sums the cells between the two passes.
     template <int dim, typename Real, typename Backend, typename Exchange = NoGridExchange>
     void average_cell_pressure(Backend &backend, const GridView<dim, Real> &g, const PointsView<dim, Real> &p,
                                const Exchange &exchange = Exchange())
@@ -412,8 +413,8 @@ namespace mpm
         Backend::add(&g.cell_volume[c], V);
         Backend::add(&g.cell_pressure_volume[c], V * mean);
       });
-      // MPI: a cell near a partition boundary holds points of two ranks (points sit up to
-      // half a cell outside their home cell before they migrate): sum the cells over ranks.
+      // MPI: a cell near a partition boundary holds points of two ranks (a point that has
+      // not migrated yet sits less than a cell outside its home cell): sum over ranks.
       Real *cell_sums[2] = {g.cell_volume, g.cell_pressure_volume};
       sum_cells(exchange, cell_sums, 2, 0);
       backend.gather_points(p.n_points, [=] MPM_HOST_DEVICE(const int i) {
