@@ -129,7 +129,8 @@ namespace mpm
     prm.declare_entry("Pressure averaging", "false", Patterns::Bool(),
                       "true: after the constitutive update every point of a grid cell gets the volume-weighted "
                       "mean pressure of the points in that cell (deviatoric stress kept), against volumetric "
-                      "locking, as in ep2-3De. false: no averaging.");
+                      "locking, as in ep2-3De. false: no averaging. MPI runs: cells near partition boundaries are "
+                      "summed over ranks.");
     prm.declare_entry("Maximum number of steps", "0", Patterns::Integer(0),
                       "Stop after this many steps even before End time; 0 = no limit.");
     prm.leave_subsection();
@@ -228,7 +229,8 @@ namespace mpm
                       "MPI runs: the points are re-sorted into cells and ranks (migrating to the rank owning their "
                       "new cell) as soon as one point is this fraction of the safe distance outside the cell it was "
                       "sorted into (the safe distance, half a cell for GIMP and one cell for linear shape functions, "
-                      "keeps its stencil within the rank's nodes). 1 = only when needed, 0 = every step.");
+                      "keeps its stencil within the rank's nodes). 1 = only when needed, 0 = every step. With "
+                      "Solver/Pressure averaging, at most half a cell (the cell sums cover the ghost cells).");
     prm.declare_entry("Load balance threshold", "1.1", Patterns::Double(0),
                       "MPI runs: the grid is repartitioned by work (cells weighted by their points) when the largest "
                       "work of one rank exceeds this multiple of the mean; checked at the start and after each "
