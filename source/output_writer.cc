@@ -19,7 +19,6 @@ namespace mpm
     using Ranges = std::vector<std::tuple<unsigned int, unsigned int, std::string,
                                           dealii::DataComponentInterpretation::DataComponentInterpretation>>;
 
-
     // Piece and record names as DataOutInterface::write_vtu_with_pvtu_record writes them
     // (one piece per rank: name_CCCCC.R.vtu and name_CCCCC.pvtu), with K pieces per rank
     // numbered R K + k.

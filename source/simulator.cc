@@ -294,8 +294,10 @@ namespace mpm
               << " bytes per step (" << arrays << " nodal arrays, each ghost value sent to its owner and back)\n";
       }
     pcout << "  output: " << output.n_outputs() << " outputs, " << output.task_seconds()
-          << " s building and writing files (rank 0, " << (parameters.output_in_background ? "background threads" : "in line")
-          << "), " << output.waited_seconds() << " s of it waited for\n";
+          << " s building and writing files on rank 0";
+    if (parameters.output_in_background)
+      pcout << " (background threads; the run waited " << output.waited_seconds() << " s for them)";
+    pcout << "\n";
     pcout
           << "  results: " << output.directory() << "/particles.pvd, " << output.directory()
           << "/grid.pvd, " << output.directory() << "/history.csv" << std::endl;
