@@ -84,11 +84,19 @@ namespace mpm
       return index;
     };
 
+    // Cells for the per-cell sums of the pressure averaging: deal.II's partitioner of the
+    // global active cell indices has the owned cells and the ghost layer.
+    cell_partitioner = triangulation.global_active_cell_index_partitioner().lock();
+    lattice_cell_of_local_cell.assign(cell_partitioner->locally_owned_size() + cell_partitioner->n_ghost_indices(),
+                                      -1);
+
     // Owned and ghost cells: their vertices are exactly the locally relevant nodes.
     for (const auto &cell : dof_handler.active_cell_iterators())
       {
         if (cell->is_artificial())
           continue;
+        lattice_cell_of_local_cell[cell_partitioner->global_to_local(cell->global_active_cell_index())] =
+          lattice_index(cell->center(), true);
         if (cell->is_locally_owned())
           cell_of_lattice_cell[lattice_index(cell->center(), true)] = cell;
         for (const unsigned int v : cell->vertex_indices())
@@ -193,9 +201,42 @@ namespace mpm
   {
     if (n_ranks == 1)
       return;
-    const unsigned int n_owned  = partitioner->locally_owned_size();
-    const unsigned int n_ghost  = partitioner->n_ghost_indices();
-    const unsigned int n_import = partitioner->n_import_indices();
+    exchange_add(*partitioner, arrays, count);
+  }
+
+  // Cells: gather the owned and ghost cells' entries into the partitioner's layout,
+  // exchange as for the nodes, scatter back. Each rank's cell sums then hold all points
+  // of the cell, on whichever rank they are.
+  template <int dim>
+  template <typename Real>
+  void BackgroundGrid<dim>::sum_cells(Real *const *arrays, const int count) const
+  {
+    if (n_ranks == 1)
+      return;
+    const std::size_t  n_local = lattice_cell_of_local_cell.size();
+    std::vector<Real> &buffer  = buffer_of<Real>(cell_buffer_double, cell_buffer_float);
+    buffer.resize(count * n_local);
+    std::vector<Real *> local(count);
+    for (int i = 0; i < count; ++i)
+      {
+        local[i] = buffer.data() + i * n_local;
+        for (std::size_t c = 0; c < n_local; ++c)
+          local[i][c] = arrays[i][lattice_cell_of_local_cell[c]];
+      }
+    exchange_add(*cell_partitioner, local.data(), count);
+    for (int i = 0; i < count; ++i)
+      for (std::size_t c = 0; c < n_local; ++c)
+        arrays[i][lattice_cell_of_local_cell[c]] = local[i][c];
+  }
+
+  template <int dim>
+  template <typename Real>
+  void BackgroundGrid<dim>::exchange_add(const dealii::Utilities::MPI::Partitioner &partitioner,
+                                         Real *const *arrays, const int count) const
+  {
+    const unsigned int n_owned  = partitioner.locally_owned_size();
+    const unsigned int n_ghost  = partitioner.n_ghost_indices();
+    const unsigned int n_import = partitioner.n_import_indices();
     std::vector<Real> &buffer   = buffer_of<Real>(buffer_double, buffer_float);
     buffer.resize(std::size_t(count) * n_import);
     requests.resize(std::max<std::size_t>(requests.size(), count));
@@ -206,16 +247,16 @@ namespace mpm
     auto temp  = [&](const int i) { return ArrayView<Real>(buffer.data() + std::size_t(i) * n_import, n_import); };
 
     for (int i = 0; i < count; ++i)
-      partitioner->import_from_ghosted_array_start(dealii::VectorOperation::add, i, ghost(i), temp(i), requests[i]);
+      partitioner.import_from_ghosted_array_start(dealii::VectorOperation::add, i, ghost(i), temp(i), requests[i]);
     for (int i = 0; i < count; ++i)
-      partitioner->import_from_ghosted_array_finish(dealii::VectorOperation::add,
+      partitioner.import_from_ghosted_array_finish(dealii::VectorOperation::add,
                                                     ArrayView<const Real>(temp(i).data(), n_import), owned(i),
                                                     ghost(i), requests[i]);
     for (int i = 0; i < count; ++i)
-      partitioner->export_to_ghosted_array_start(i, ArrayView<const Real>(arrays[i], n_owned), temp(i), ghost(i),
+      partitioner.export_to_ghosted_array_start(i, ArrayView<const Real>(arrays[i], n_owned), temp(i), ghost(i),
                                                  requests[i]);
     for (int i = 0; i < count; ++i)
-      partitioner->export_to_ghosted_array_finish(ghost(i), requests[i]);
+      partitioner.export_to_ghosted_array_finish(ghost(i), requests[i]);
   }
 
   template class BackgroundGrid<2>;
@@ -224,4 +265,8 @@ namespace mpm
   template void BackgroundGrid<3>::sum_nodal(double *const *, int) const;
   template void BackgroundGrid<2>::sum_nodal(float *const *, int) const;
   template void BackgroundGrid<3>::sum_nodal(float *const *, int) const;
+  template void BackgroundGrid<2>::sum_cells(double *const *, int) const;
+  template void BackgroundGrid<3>::sum_cells(double *const *, int) const;
+  template void BackgroundGrid<2>::sum_cells(float *const *, int) const;
+  template void BackgroundGrid<3>::sum_cells(float *const *, int) const;
 } // namespace mpm

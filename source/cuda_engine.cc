@@ -31,20 +31,30 @@ namespace mpm
 
       void load(const MaterialPoints<dim> &p) override
       {
-        p.copy_to(host);
+        auto new_labels = std::make_shared<PointLabels<dim>>();
+        p.copy_to(host, nullptr, new_labels.get());
+        labels = std::move(new_labels); // a snapshot being written keeps the old ones
         device.upload_points(host);
       }
 
-      // Output and end of run: points (and nodal fields, for the grid output) come back,
-      // points that left the grid are removed, the handler's new order goes back down.
+      // End of run: points come back, points that left the grid are removed, the
+      // handler's new order goes back down.
       unsigned int store(MaterialPoints<dim> &p) override
       {
         device.download_points(host);
-        device.download_nodal(grid.view());
         const unsigned int removed = p.copy_from(host);
-        p.copy_to(host);
-        device.upload_points(host);
+        load(p);
         return removed;
+      }
+
+      // Output: points and nodal fields come down; the device keeps the points in the
+      // order of the last upload (DeviceEngine's contract), which is the labels' order.
+      void snapshot(PointSnapshot<dim> &s) override
+      {
+        s.points.resize(host.size());
+        device.download_points(s.points);
+        device.download_nodal(grid.view());
+        s.labels = labels;
       }
 
       StepReduction<double> step(const StepSettings<dim, double> &s, const double dt) override
@@ -69,6 +79,7 @@ namespace mpm
       BackgroundGrid<dim>      &grid;
       cuda::DeviceEngine<dim>   device;
       HostPoints<dim, double>   host; // staging for load/store only
+      std::shared_ptr<const PointLabels<dim>> labels; // id, initial position, in the uploaded order
     };
   } // namespace
 #endif

@@ -26,13 +26,25 @@ namespace mpm
         cell_pressure_volume.assign(n_cells, 0.);
       }
 
-      void load(const MaterialPoints<dim> &p) override { p.copy_to(points, &home_cells); }
+      void load(const MaterialPoints<dim> &p) override
+      {
+        auto new_labels = std::make_shared<PointLabels<dim>>();
+        p.copy_to(points, &home_cells, new_labels.get());
+        labels = std::move(new_labels); // a snapshot being written keeps the old ones
+      }
 
       unsigned int store(MaterialPoints<dim> &p) override
       {
         const unsigned int removed = p.copy_from(points);
-        p.copy_to(points, &home_cells); // the handler re-sorted them: take the new order
+        load(p); // the handler re-sorted them: take the new order
         return removed;
+      }
+
+      // The grid's vectors are the engine's nodal arrays: already up to date.
+      void snapshot(PointSnapshot<dim> &s) override
+      {
+        s.points = points;
+        s.labels = labels;
       }
 
       double max_distance_outside_home_cells() override
@@ -76,6 +88,7 @@ namespace mpm
       CpuBackend                              backend;
       HostPoints<dim, double>                 points;
       std::vector<long>                       home_cells; // lattice cell of each point at the last sort
+      std::shared_ptr<const PointLabels<dim>> labels;     // id, initial position, in the order of points
       std::vector<double>                     cell_volume, cell_pressure_volume; // pressure-averaging scratch
     };
   } // namespace

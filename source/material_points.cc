@@ -244,16 +244,30 @@ namespace mpm
   }
 
   template <int dim>
-  void MaterialPoints<dim>::copy_to(HostPoints<dim, double> &p, std::vector<long> *home_cells) const
+  void MaterialPoints<dim>::copy_to(HostPoints<dim, double> &p, std::vector<long> *home_cells,
+                                    PointLabels<dim> *labels) const
   {
     using Layout = PropertyLayout<dim>;
+    const unsigned int n = handler.n_locally_owned_particles();
     p.resize(0);
-    p.resize(handler.n_locally_owned_particles());
+    p.resize(n);
     if (home_cells)
-      home_cells->resize(handler.n_locally_owned_particles());
+      home_cells->resize(n);
+    if (labels)
+      {
+        labels->id.resize(n);
+        for (int d = 0; d < dim; ++d)
+          labels->initial_position[d].resize(n);
+      }
     int i = 0;
     for (const auto &particle : handler)
       {
+        if (labels)
+          {
+            labels->id[i] = particle.get_id();
+            for (int d = 0; d < dim; ++d)
+              labels->initial_position[d][i] = particle.get_properties()[Layout::initial_position + d];
+          }
         if (home_cells)
           {
             const auto center = particle.get_surrounding_cell()->center();
@@ -286,6 +300,35 @@ namespace mpm
         p.material[i]       = static_cast<int>(prop[Layout::material]);
         ++i;
       }
+  }
+
+  // The inverse of copy_to's property reads: where copy_to reads prop[k] into an array,
+  // this writes that array back to values[k]; initial_position comes from the labels.
+  template <int dim>
+  void PointSnapshot<dim>::properties(const int i, double *values) const
+  {
+    using Layout       = PropertyLayout<dim>;
+    const auto &p      = points;
+    values[Layout::mass]           = p.mass[i];
+    values[Layout::volume]         = p.volume[i];
+    values[Layout::initial_volume] = p.initial_volume[i];
+    for (int d = 0; d < dim; ++d)
+      {
+        values[Layout::velocity + d]                   = p.velocity[d][i];
+        values[Layout::domain_half_length + d]         = p.domain_half_length[d][i];
+        values[Layout::initial_domain_half_length + d] = p.initial_domain_half_length[d][i];
+        values[Layout::initial_position + d]           = labels->initial_position[d][i];
+      }
+    for (int c = 0; c < n_voigt; ++c)
+      {
+        values[Layout::stress + c] = p.stress[c][i];
+        values[Layout::strain + c] = p.strain[c][i];
+      }
+    for (int c = 0; c < dim * dim; ++c)
+      values[Layout::deformation_gradient + c] = p.deformation_gradient[c][i];
+    values[Layout::plastic_strain] = p.plastic_strain[i];
+    values[Layout::material]       = p.material[i];
+    values[Layout::material_field] = p.material_field[i];
   }
 
   template <int dim>
@@ -352,6 +395,8 @@ namespace mpm
     grid.distribute_nodes();
   }
 
+  template struct PointSnapshot<2>;
+  template struct PointSnapshot<3>;
   template struct PropertyLayout<2>;
   template struct PropertyLayout<3>;
   template class MaterialPoints<2>;

@@ -2,29 +2,255 @@
 
 #include <deal.II/base/exceptions.h>
 #include <deal.II/base/mpi.h>
+#include <deal.II/base/utilities.h>
 #include <deal.II/numerics/data_out.h>
-#include <deal.II/particles/data_out.h>
 
+#include <chrono>
 #include <filesystem>
+#include <functional>
 #include <iomanip>
+#include <memory>
 #include <sstream>
 
 namespace mpm
 {
+  namespace
+  {
+    using Ranges = std::vector<std::tuple<unsigned int, unsigned int, std::string,
+                                          dealii::DataComponentInterpretation::DataComponentInterpretation>>;
+
+    // Piece and record names as DataOutInterface::write_vtu_with_pvtu_record writes them
+    // (one piece per rank: name_CCCCC.R.vtu and name_CCCCC.pvtu), with K pieces per rank
+    // numbered R K + k.
+    std::string piece_name(const std::string &name, const unsigned int counter, const unsigned int piece,
+                           const unsigned int n_pieces)
+    {
+      return name + "_" + dealii::Utilities::int_to_string(counter, 5) + "." +
+             dealii::Utilities::int_to_string(piece, dealii::Utilities::needed_digits(n_pieces - 1)) + ".vtu";
+    }
+    std::string record_name(const std::string &name, const unsigned int counter)
+    {
+      return name + "_" + dealii::Utilities::int_to_string(counter, 5) + ".pvtu";
+    }
+
+    // One .vtu piece (number piece of n_pieces); with write_records also the .pvtu record
+    // of all pieces and the .pvd time series (rank 0, once per output).
+    template <int patch_dim, int spacedim>
+    void write_piece(const dealii::DataOutInterface<patch_dim, spacedim> &out, const std::string &directory,
+                     const std::string &name, const unsigned int counter, const unsigned int piece,
+                     const unsigned int n_pieces, const bool write_records,
+                     const std::vector<std::pair<double, std::string>> &records)
+    {
+      const std::string file_name = directory + "/" + piece_name(name, counter, piece, n_pieces);
+      std::ofstream     file(file_name);
+      AssertThrow(file, dealii::ExcMessage("Parameter 'Output/Directory': cannot write '" + file_name + "'."));
+      out.write_vtu(file);
+      AssertThrow(file, dealii::ExcMessage("Parameter 'Output/Directory': writing '" + file_name + "' failed."));
+      if (!write_records)
+        return;
+      std::vector<std::string> pieces;
+      for (unsigned int r = 0; r < n_pieces; ++r)
+        pieces.push_back(piece_name(name, counter, r, n_pieces));
+      std::ofstream pvtu(directory + "/" + record_name(name, counter));
+      out.write_pvtu_record(pvtu, pieces);
+      std::ofstream pvd(directory + "/" + name + ".pvd");
+      dealii::DataOutBase::write_pvd_record(pvd, records);
+    }
+
+    // Patches, names and vector ranges owned by value: one piece of a DataOut's patches.
+    template <int dim>
+    class GridPiece : public dealii::DataOutInterface<dim, dim>
+    {
+    public:
+      std::vector<dealii::DataOutBase::Patch<dim, dim>> patches;
+      std::vector<std::string>                          names;
+      Ranges                                            ranges;
+
+    protected:
+      const std::vector<dealii::DataOutBase::Patch<dim, dim>> &get_patches() const override { return patches; }
+      std::vector<std::string> get_dataset_names() const override { return names; }
+      Ranges                   get_nonscalar_data_ranges() const override { return ranges; }
+    };
+
+    // DataOut whose built patches can be split into pieces (each written on its own thread).
+    template <int dim>
+    class GridDataOut : public dealii::DataOut<dim>
+    {
+    public:
+      std::vector<GridPiece<dim>> split(const unsigned int n_pieces)
+      {
+        std::vector<GridPiece<dim>> pieces(n_pieces);
+        const std::size_t           n = this->patches.size();
+        for (unsigned int k = 0; k < n_pieces; ++k)
+          {
+            pieces[k].names  = this->get_dataset_names();
+            pieces[k].ranges = this->get_nonscalar_data_ranges();
+            pieces[k].patches.assign(std::make_move_iterator(this->patches.begin() + n * k / n_pieces),
+                                     std::make_move_iterator(this->patches.begin() + n * (k + 1) / n_pieces));
+          }
+        this->patches.clear();
+        return pieces;
+      }
+    };
+
+    // Runs the tasks on their own threads and waits for all; rethrows the first error.
+    void run_all(std::vector<std::function<void()>> &tasks)
+    {
+      std::vector<std::future<void>> running;
+      for (unsigned int k = 1; k < tasks.size(); ++k)
+        running.push_back(std::async(std::launch::async, tasks[k]));
+      std::exception_ptr error;
+      try
+        {
+          if (!tasks.empty())
+            tasks[0]();
+        }
+      catch (...)
+        {
+          error = std::current_exception();
+        }
+      for (auto &task : running)
+        try
+          {
+            task.get();
+          }
+        catch (...)
+          {
+            if (!error)
+              error = std::current_exception();
+          }
+      if (error)
+        std::rethrow_exception(error);
+    }
+
+    // Full-precision table of one rank's points: id, position, every property.
+    template <int dim>
+    void write_point_table(const PointSnapshot<dim> &snapshot, const std::string &file_name)
+    {
+      std::ofstream table(file_name);
+      AssertThrow(table, dealii::ExcMessage("Parameter 'Output/Directory': cannot write '" + file_name + "'."));
+      const auto names = PropertyLayout<dim>::names();
+      table << "id";
+      for (int d = 0; d < dim; ++d)
+        table << ",position_" << "xyz"[d];
+      std::vector<unsigned int> seen(names.size(), 0);
+      for (unsigned int k = 0; k < names.size(); ++k)
+        {
+          // Vector properties repeat their name: number their components.
+          unsigned int repeats = 0;
+          for (unsigned int j = 0; j < names.size(); ++j)
+            repeats += names[j] == names[k];
+          table << ',' << names[k];
+          if (repeats > 1)
+            table << '_' << "xyz"[seen[k]];
+          for (unsigned int j = k + 1; j < names.size(); ++j)
+            if (names[j] == names[k])
+              seen[j] = seen[k] + 1;
+        }
+      table << '\n' << std::setprecision(17);
+      const auto         &p = snapshot.points;
+      std::vector<double> values(PropertyLayout<dim>::n_properties);
+      for (int i = 0; i < p.size(); ++i)
+        {
+          if (p.material[i] < 0)
+            continue; // left the grid
+          snapshot.properties(i, values.data());
+          table << snapshot.labels->id[i];
+          for (int d = 0; d < dim; ++d)
+            table << ',' << p.position[d][i];
+          for (const double value : values)
+            table << ',' << value;
+          table << '\n';
+        }
+    }
+  } // namespace
+
+  template <int dim>
+  void PointDataOut<dim>::build_patches(const PointSnapshot<dim> &snapshot, const int begin, const int end)
+  {
+    const auto        &p            = snapshot.points;
+    const unsigned int n_properties = PropertyLayout<dim>::n_properties;
+    const int          last         = end < 0 ? p.size() : end;
+    unsigned int       n            = 0;
+    for (int i = begin; i < last; ++i)
+      n += p.material[i] >= 0;
+    patches.clear();
+    patches.resize(n);
+    std::vector<double> values(n_properties);
+    unsigned int        k = 0;
+    for (int i = begin; i < last; ++i)
+      {
+        if (p.material[i] < 0)
+          continue; // left the grid
+        auto &patch = patches[k];
+        for (int d = 0; d < dim; ++d)
+          patch.vertices[0][d] = p.position[d][i];
+        patch.patch_index = k;
+        patch.data.reinit(n_properties + 1, 1);
+        patch.data(0, 0) = snapshot.labels->id[i];
+        snapshot.properties(i, values.data());
+        for (unsigned int c = 0; c < n_properties; ++c)
+          patch.data(c + 1, 0) = values[c];
+        ++k;
+      }
+  }
+
+  template <int dim>
+  std::vector<std::string> PointDataOut<dim>::get_dataset_names() const
+  {
+    std::vector<std::string> names = {"id"};
+    for (const auto &name : PropertyLayout<dim>::names())
+      names.push_back(name);
+    return names;
+  }
+
+  // Consecutive vector components of one name form one range, as in Particles::DataOut.
+  template <int dim>
+  Ranges PointDataOut<dim>::get_nonscalar_data_ranges() const
+  {
+    using namespace dealii::DataComponentInterpretation;
+    const auto names = get_dataset_names();
+    std::vector<DataComponentInterpretation> kinds = {component_is_scalar};
+    for (const auto kind : PropertyLayout<dim>::interpretations())
+      kinds.push_back(kind);
+    Ranges ranges;
+    for (unsigned int i = 0; i < names.size();)
+      if (kinds[i] == component_is_part_of_vector)
+        {
+          unsigned int n = 1;
+          while (i + n < names.size() && kinds[i + n] == component_is_part_of_vector && names[i + n] == names[i])
+            ++n;
+          ranges.emplace_back(i, i + n - 1, names[i], component_is_part_of_vector);
+          i += n;
+        }
+      else
+        ++i;
+    return ranges;
+  }
+
   template <int dim>
   OutputWriter<dim>::OutputWriter(const Parameters &parameters, MPI_Comm communicator)
     : communicator(communicator)
+    , rank(dealii::Utilities::MPI::this_mpi_process(communicator))
+    , n_ranks(dealii::Utilities::MPI::n_mpi_processes(communicator))
     , output_directory(parameters.output_directory)
     , write_grid(parameters.write_grid_fields)
     , write_particles(parameters.write_particles)
     , write_table(parameters.write_particle_table)
+    , background(parameters.output_in_background)
+    , pieces_per_rank(parameters.output_files_per_rank)
   {
     if (output_directory.empty())
       output_directory = ".";
+    using Flags = dealii::DataOutBase::VtkFlags;
+    vtk_flags.compression_level = parameters.output_compression == "no compression"   ? Flags::no_compression :
+                                  parameters.output_compression == "best compression" ? Flags::best_compression :
+                                  parameters.output_compression == "default"          ? Flags::default_compression :
+                                                                                        Flags::best_speed;
     // Rank 0 creates the folder and the history; every rank learns whether that worked,
     // so that a bad Output/Directory stops all ranks with one message instead of a hang.
     std::string problem;
-    if (dealii::Utilities::MPI::this_mpi_process(communicator) == 0)
+    if (rank == 0)
       {
         std::error_code error;
         std::filesystem::create_directories(output_directory, error);
@@ -39,7 +265,7 @@ namespace mpm
       }
     problem = dealii::Utilities::MPI::broadcast(communicator, problem, 0);
     AssertThrow(problem.empty(), dealii::ExcMessage("Parameter 'Output/Directory': " + problem));
-    if (dealii::Utilities::MPI::this_mpi_process(communicator) == 0)
+    if (rank == 0)
       {
         history << "time,dt,step,kinetic_energy,work_of_gravity,total_mass";
         for (int d = 0; d < dim; ++d)
@@ -55,82 +281,113 @@ namespace mpm
   }
 
   template <int dim>
-  void OutputWriter<dim>::write_fields(const double time, BackgroundGrid<dim> &grid, const MaterialPoints<dim> &points)
+  OutputWriter<dim>::~OutputWriter()
   {
-    const bool root = dealii::Utilities::MPI::this_mpi_process(communicator) == 0;
+    for (auto &task : in_flight)
+      task.wait();
+  }
+
+  template <int dim>
+  void OutputWriter<dim>::finish()
+  {
+    std::vector<std::future<void>> tasks;
+    tasks.swap(in_flight);
+    const auto start = std::chrono::steady_clock::now();
+    for (auto &task : tasks)
+      task.wait();
+    waited += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    for (auto &task : tasks)
+      task.get(); // rethrows the first error
+  }
+
+  template <int dim>
+  PointSnapshot<dim> &OutputWriter<dim>::next_snapshot()
+  {
+    finish();
+    return snapshot;
+  }
+
+  template <int dim>
+  void OutputWriter<dim>::write_fields(const double time, BackgroundGrid<dim> &grid)
+  {
+    finish();
+    // What the background tasks read is copied now. DataOut::add_data_vector makes its own
+    // ghosted copy of each vector (MPI: here, on this thread); build_patches then reads
+    // those copies and the DoFHandler as it is (it changes only in a repartition, which
+    // calls finish() first) and does no communication.
+    std::shared_ptr<GridDataOut<dim>> grid_out;
     if (write_grid)
       {
-        dealii::DataOut<dim> out;
-        out.attach_dof_handler(grid.dof_handler);
-        grid.mass.update_ghost_values();
-        out.add_data_vector(grid.mass, "nodal_mass");
+        grid_out = std::make_shared<GridDataOut<dim>>();
+        grid_out->attach_dof_handler(grid.dof_handler);
+        grid_out->add_data_vector(grid.mass, "nodal_mass");
         const char *names[3] = {"nodal_velocity_x", "nodal_velocity_y", "nodal_velocity_z"};
         for (int d = 0; d < dim; ++d)
-          {
-            grid.velocity[d].update_ghost_values();
-            out.add_data_vector(grid.velocity[d], names[d]);
-          }
+          grid_out->add_data_vector(grid.velocity[d], names[d]);
         dealii::Vector<float> subdomain(grid.triangulation.n_active_cells());
-        subdomain = dealii::Utilities::MPI::this_mpi_process(communicator);
-        out.add_data_vector(subdomain, "subdomain");
-        out.build_patches();
-        const std::string name = out.write_vtu_with_pvtu_record(output_directory + "/", "grid", counter, communicator, 5);
-        grid_records.emplace_back(time, name);
-        if (root)
-          {
-            std::ofstream pvd(output_directory + "/grid.pvd");
-            dealii::DataOutBase::write_pvd_record(pvd, grid_records);
-          }
+        subdomain = rank;
+        grid_out->add_data_vector(subdomain, "subdomain");
+        grid_records.emplace_back(time, record_name("grid", counter));
       }
     if (write_particles)
+      particle_records.emplace_back(time, record_name("particles", counter));
+
+    // Two tasks, each reading only what it owns (the snapshot is not touched until finish());
+    // each writes its Output/Files per rank pieces on as many threads.
+    const unsigned int K = pieces_per_rank;
+    auto grid_task = [this, grid_out, K, counter = counter, records = grid_records]() {
+      grid_out->build_patches();
+      auto                               pieces = grid_out->split(K);
+      std::vector<std::function<void()>> writes;
+      for (unsigned int k = 0; k < K; ++k)
+        writes.emplace_back([&, k]() {
+          pieces[k].set_flags(vtk_flags);
+          write_piece(pieces[k], output_directory, "grid", counter, rank * K + k, n_ranks * K, rank == 0 && k == 0,
+                      records);
+        });
+      run_all(writes);
+    };
+    auto point_task = [this, K, counter = counter, records = particle_records]() {
+      if (write_particles)
+        {
+          std::vector<std::function<void()>> writes;
+          const int                          n = snapshot.points.size();
+          for (unsigned int k = 0; k < K; ++k)
+            writes.emplace_back([&, k]() {
+              PointDataOut<dim> out;
+              out.set_flags(vtk_flags);
+              out.build_patches(snapshot, int(long(n) * k / K), int(long(n) * (k + 1) / K));
+              write_piece(out, output_directory, "particles", counter, rank * K + k, n_ranks * K,
+                          rank == 0 && k == 0, records);
+            });
+          run_all(writes);
+        }
+      if (write_table)
+        {
+          std::ostringstream name;
+          name << output_directory << "/particle_table_" << std::setw(5) << std::setfill('0') << counter << '.'
+               << rank << ".csv";
+          write_point_table(snapshot, name.str());
+        }
+    };
+    std::vector<std::function<void()>> tasks;
+    if (write_grid)
+      tasks.emplace_back(grid_task);
+    if (write_particles || write_table)
+      tasks.emplace_back(point_task);
+    for (auto &task : tasks)
       {
-        dealii::Particles::DataOut<dim> out;
-        out.build_patches(points.handler, PropertyLayout<dim>::names(), PropertyLayout<dim>::interpretations());
-        const std::string name =
-          out.write_vtu_with_pvtu_record(output_directory + "/", "particles", counter, communicator, 5);
-        particle_records.emplace_back(time, name);
-        if (root)
-          {
-            std::ofstream pvd(output_directory + "/particles.pvd");
-            dealii::DataOutBase::write_pvd_record(pvd, particle_records);
-          }
-      }
-    if (write_table)
-      {
-        const unsigned int rank = dealii::Utilities::MPI::this_mpi_process(communicator);
-        std::ostringstream name;
-        name << output_directory << "/particle_table_" << std::setw(5) << std::setfill('0') << counter << '.'
-             << rank << ".csv";
-        std::ofstream table(name.str());
-        AssertThrow(table, dealii::ExcMessage("Parameter 'Output/Directory': cannot write '" + name.str() + "'."));
-        const auto names = PropertyLayout<dim>::names();
-        table << "id";
-        for (int d = 0; d < dim; ++d)
-          table << ",position_" << "xyz"[d];
-        std::vector<unsigned int> seen(names.size(), 0);
-        for (unsigned int k = 0; k < names.size(); ++k)
-          {
-            // Vector properties repeat their name: number their components.
-            unsigned int repeats = 0;
-            for (unsigned int j = 0; j < names.size(); ++j)
-              repeats += names[j] == names[k];
-            table << ',' << names[k];
-            if (repeats > 1)
-              table << '_' << "xyz"[seen[k]];
-            for (unsigned int j = k + 1; j < names.size(); ++j)
-              if (names[j] == names[k])
-                seen[j] = seen[k] + 1;
-          }
-        table << '\n' << std::setprecision(17);
-        for (const auto &particle : points.handler)
-          {
-            table << particle.get_id();
-            for (int d = 0; d < dim; ++d)
-              table << ',' << particle.get_location()[d];
-            for (const double value : particle.get_properties())
-              table << ',' << value;
-            table << '\n';
-          }
+        auto timed = [this, task]() {
+          const auto start = std::chrono::steady_clock::now();
+          task();
+          task_nanoseconds += std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                std::chrono::steady_clock::now() - start)
+                                .count();
+        };
+        if (background)
+          in_flight.push_back(std::async(std::launch::async, timed));
+        else
+          timed();
       }
     ++counter;
   }

@@ -129,7 +129,8 @@ namespace mpm
     prm.declare_entry("Pressure averaging", "false", Patterns::Bool(),
                       "true: after the constitutive update every point of a grid cell gets the volume-weighted "
                       "mean pressure of the points in that cell (deviatoric stress kept), against volumetric "
-                      "locking, as in ep2-3De. false: no averaging.");
+                      "locking, as in ep2-3De. false: no averaging. MPI runs: cells near partition boundaries are "
+                      "summed over ranks.");
     prm.declare_entry("Maximum number of steps", "0", Patterns::Integer(0),
                       "Stop after this many steps even before End time; 0 = no limit.");
     prm.leave_subsection();
@@ -209,6 +210,19 @@ namespace mpm
     prm.declare_entry("Write particle table", "false", Patterns::Bool(),
                       "Also write particle_table_NNNNN.R.csv (one per output and rank R): id, position and every "
                       "property in full precision, for comparisons the single-precision .vtu files cannot resolve.");
+    prm.declare_entry("Compression", "best speed",
+                      Patterns::Selection("best speed|default|best compression|no compression"),
+                      "zlib compression level of the .vtu files (deal.II's VtkFlags::compression_level). best "
+                      "speed: about as small as the others for MPM data, several times faster to write than "
+                      "best compression (doc/performance.md, Output).");
+    prm.declare_entry("Write in background", "true", Patterns::Bool(),
+                      "Build, compress and write the output files on a background thread while the steps go on; "
+                      "the points are copied first (one snapshot), so the steps cannot change what is written. "
+                      "false: the run waits for each output to be written.");
+    prm.declare_entry("Files per rank", "1", Patterns::Integer(1, 256),
+                      "Each rank writes its grid cells and its points as this many .vtu pieces per output (the "
+                      ".pvtu record lists them all), built, compressed and written on as many threads: more than "
+                      "1 speeds up the output of large scenes on many cores.");
     prm.leave_subsection();
 
     prm.enter_subsection("Parallel");
@@ -216,7 +230,8 @@ namespace mpm
                       "MPI runs: the points are re-sorted into cells and ranks (migrating to the rank owning their "
                       "new cell) as soon as one point is this fraction of the safe distance outside the cell it was "
                       "sorted into (the safe distance, half a cell for GIMP and one cell for linear shape functions, "
-                      "keeps its stencil within the rank's nodes). 1 = only when needed, 0 = every step.");
+                      "keeps its stencil within the rank's nodes). 1 = only when needed, 0 = every step. With "
+                      "Solver/Pressure averaging, at most half a cell (the cell sums cover the ghost cells).");
     prm.declare_entry("Load balance threshold", "1.1", Patterns::Double(0),
                       "MPI runs: the grid is repartitioned by work (cells weighted by their points) when the largest "
                       "work of one rank exceeds this multiple of the mean; checked at the start and after each "
@@ -432,6 +447,9 @@ namespace mpm
     history_every     = prm.get_integer("History every n steps");
     progress_interval = prm.get_double("Progress interval");
     write_particle_table = prm.get_bool("Write particle table");
+    output_compression   = prm.get("Compression");
+    output_in_background = prm.get_bool("Write in background");
+    output_files_per_rank = prm.get_integer("Files per rank");
     prm.leave_subsection();
 
     prm.enter_subsection("Parallel");

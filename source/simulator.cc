@@ -56,11 +56,6 @@ namespace mpm
   template <int dim>
   void Simulator<dim>::run()
   {
-    // Pressure averaging sums over the points of a cell; between re-sorts a cell's points
-    // can sit on two ranks, and cell sums are not exchanged between ranks yet.
-    AssertThrow(!(parameters.pressure_averaging && dealii::Utilities::MPI::n_mpi_processes(communicator) > 1),
-                dealii::ExcMessage("Parameter 'Solver/Pressure averaging': not supported on more than one MPI rank "
-                                   "yet (cell sums are not exchanged); run on one rank or set it to false."));
     const double c_el = elastic_wave_speed(parameters);
     const double h    = parameters.cell_size;
     if (!parameters.adaptive_time_step)
@@ -88,9 +83,16 @@ namespace mpm
     bool plastic = !(parameters.plasticity_start_time > 0);
     for (auto &m : materials)
       m.plasticity_enabled = plastic;
+    OutputWriter<dim> output(parameters, communicator);
     // MPI: points re-sorted into cells and ranks, grid repartitioned by work.
     const bool   parallel  = dealii::Utilities::MPI::n_mpi_processes(communicator) > 1;
-    const double resort_at = parameters.resort_distance * safe_distance_outside_home_cell(parameters.shape_function);
+    // Pressure averaging in parallel: a point's cell at the end of a step must be an owned
+    // or ghost cell of its rank (whose cell sums the exchange covers), i.e. less than one
+    // cell outside its home cell. Re-sorting at half a cell (GIMP's safe distance already)
+    // leaves a step's displacement of room; the check after each step asserts it.
+    const double resort_at =
+      std::min(parameters.resort_distance * safe_distance_outside_home_cell(parameters.shape_function),
+               parallel && parameters.pressure_averaging ? 0.5 : 1e300);
     long         n_resorts = 0, n_repartitions = 0;
     double       balanced  = 1; // imbalance right after the last repartition: what p4est achieves
     // Repartition when the work per rank is out of balance by more than the threshold and
@@ -105,6 +107,7 @@ namespace mpm
           before <= balanced + 0.5 * (parameters.load_balance_threshold - 1))
         return false;
       dealii::TimerOutput::Scope scope(timer, "repartition");
+      output.finish(); // a grid output in flight reads the DoFHandler
       points.repartition();
       ++n_repartitions;
       balanced = points.imbalance();
@@ -115,7 +118,6 @@ namespace mpm
     balance();
     auto engine = make_engine<dim>(parameters.backend, grid, materials, parameters.shape_function);
     engine->load(points);
-    OutputWriter<dim> output(parameters, communicator);
     timer.leave_subsection();
 
     pcout << "dealii-mpm: " << dim << "D, " << grid.triangulation.n_global_active_cells() << " cells, "
@@ -158,10 +160,12 @@ namespace mpm
       row.n_sent              = static_cast<long>(sum(double(points.n_sent), communicator));
       output.write_history(row);
     };
+    // Output reads a snapshot of the engine's points: no hand-over to the handler, which
+    // is brought up to date only where it is needed (re-sorts, repartitions, end of run).
     auto write_output = [&]() {
       dealii::TimerOutput::Scope scope(timer, "output");
-      engine->store(points);
-      output.write_fields(time, grid, points);
+      engine->snapshot(output.next_snapshot());
+      output.write_fields(time, grid);
     };
 
     write_output();
@@ -203,6 +207,13 @@ namespace mpm
                                       dealii::ArrayView<double>(global, 3));
           max_speed         = global[0];
           max_removed_speed = global[2];
+          AssertThrow(!(parallel && parameters.pressure_averaging) || global[1] < 1,
+                      dealii::ExcMessage("Parameter 'Solver/Pressure averaging': at t = " +
+                                         dealii::Utilities::to_string(time + dt) + " s a point moved to " +
+                                         dealii::Utilities::to_string(global[1]) +
+                                         " cells outside the cell it was sorted into, beyond the ghost cells whose "
+                                         "pressure sums are exchanged between ranks. Reduce 'Solver/CFL number' or "
+                                         "the time step."));
           if (parallel && global[1] >= resort_at)
             {
               {
@@ -252,6 +263,15 @@ namespace mpm
       record_history();
     if (!(parameters.output_interval > 0 && std::abs(time - (next_output - parameters.output_interval)) < 1e-12 * end))
       write_output();
+    {
+      // The handler holds the final state (points that left the grid removed).
+      dealii::TimerOutput::Scope scope(timer, "hand-over at the end");
+      engine->store(points);
+    }
+    {
+      dealii::TimerOutput::Scope scope(timer, "output");
+      output.finish(); // the last files are complete
+    }
 
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
     const double n_now = static_cast<double>(n_points_initial - n_removed);
@@ -273,6 +293,11 @@ namespace mpm
               << static_cast<long>(max(ghosts, communicator)) << " at most on one rank; exchange " << bytes
               << " bytes per step (" << arrays << " nodal arrays, each ghost value sent to its owner and back)\n";
       }
+    pcout << "  output: " << output.n_outputs() << " outputs, " << output.task_seconds()
+          << " s building and writing files on rank 0";
+    if (parameters.output_in_background)
+      pcout << " (background threads; the run waited " << output.waited_seconds() << " s for them)";
+    pcout << "\n";
     pcout
           << "  results: " << output.directory() << "/particles.pvd, " << output.directory()
           << "/grid.pvd, " << output.directory() << "/history.csv" << std::endl;

@@ -3,10 +3,11 @@
 # balance threshold. Asserts: final positions and stresses np-invariant to 1e-10
 # (relative to the field's magnitude); on 4 ranks points migrate (counts per rank
 # change, total conserved) and the grid is repartitioned by work.
-# Usage: mpi_collapse.sh EXE SOURCE_DIR OUTDIR
+# Usage: mpi_collapse.sh EXE SOURCE_DIR OUTDIR [override lines...]
 set -eu
 exe=$1 src=$2 out=$3 here=$(dirname "$0")
+shift 3
 bash "$here/run_np.sh" "$exe" "$here/collapse_small_2d.prm" "$out" "1 2 4" \
-  "subsection Parallel" "  set Load balance threshold = 1.02" "end"
+  "subsection Parallel" "  set Load balance threshold = 1.02" "end" "$@"
 /usr/bin/python3 "$here/compare_np.py" "$out/np1" "$out/np2" "$out/np4" --rtol 1e-10
 /usr/bin/python3 "$here/compare_np.py" "$out/np1" "$out/np4" --rtol 1e-10 --migrated --repartitioned

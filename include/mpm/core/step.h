@@ -61,10 +61,15 @@ namespace mpm
 
   // Hooks between a P2G pass and the nodal update, where ranks sum their ghost
   // contributions (deal.II's Partitioner import/export in the deal.II layer). The core needs none.
+  // sum_cells: the same for the per-cell sums of the pressure averaging (arrays over
+  // lattice cells), between their scatter and their gather.
   struct NoGridExchange
   {
     template <typename Real>
     void sum_nodal(Real *const *, int) const
+    {}
+    template <typename Real>
+    void sum_cells(Real *const *, int) const
     {}
   };
 
@@ -408,14 +413,28 @@ namespace mpm
       });
     }
 
+    // exchange.sum_cells if the exchange has one; exchanges for one rank only (the CUDA
+    // engine's nodal adapter) may have none.
+    template <typename Exchange, typename Real>
+    auto sum_cells(const Exchange &exchange, Real *const *arrays, const int count, int)
+      -> decltype(exchange.sum_cells(arrays, count), void())
+    {
+      exchange.sum_cells(arrays, count);
+    }
+    template <typename Exchange, typename Real>
+    void sum_cells(const Exchange &, Real *const *, const int, long)
+    {}
+
     // Cell pressure averaging (against volumetric locking, as in ep2-3De): every point
     // of a lattice cell gets the volume-weighted mean pressure of the cell,
     //   p_c = sum_p V_p p_p / sum_p V_p,   sigma_p <- s_p - p_c I   (s_p deviatoric part kept),
     // with p = -tr(sigma)/3 (plane strain: sigma_zz included). Two passes through the
     // backend: scatter V_p and V_p p_p into per-cell sums, then gather p_c back.
     // The averaged stress is not returned to the yield surface again (ep2-3De neither).
-    template <int dim, typename Real, typename Backend>
-    void average_cell_pressure(Backend &backend, const GridView<dim, Real> &g, const PointsView<dim, Real> &p)
+    // On several ranks, exchange.sum_cells sums the cells between the two passes.
+    template <int dim, typename Real, typename Backend, typename Exchange = NoGridExchange>
+    void average_cell_pressure(Backend &backend, const GridView<dim, Real> &g, const PointsView<dim, Real> &p,
+                               const Exchange &exchange = Exchange())
     {
       if (g.cell_volume == nullptr || g.cell_pressure_volume == nullptr)
         throw std::invalid_argument("pressure averaging needs GridView::cell_volume and cell_pressure_volume");
@@ -436,6 +455,10 @@ namespace mpm
         const Real  values[2]  = {V, V * mean};
         Backend::template add_to_node<2>(targets, c, values);
       });
+      // MPI: a cell near a partition boundary holds points of two ranks (a point that has
+      // not migrated yet sits less than a cell outside its home cell): sum over ranks.
+      Real *cell_sums[2] = {g.cell_volume, g.cell_pressure_volume};
+      sum_cells(exchange, cell_sums, 2, 0);
       backend.gather_points(p.n_points, [=] MPM_HOST_DEVICE(const int i) {
         if (p.material[i] < 0)
           return;
@@ -515,7 +538,7 @@ namespace mpm
           if (s.pressure_averaging)
             {
               group_for_scatter<dim, Shape>(backend, g, p); // the points have moved
-              average_cell_pressure(backend, g, p);
+              average_cell_pressure(backend, g, p, exchange);
             }
           break;
 
@@ -530,7 +553,7 @@ namespace mpm
           if (s.pressure_averaging)
             {
               group_for_scatter<dim, Shape>(backend, g, p); // the points have moved
-              average_cell_pressure(backend, g, p);
+              average_cell_pressure(backend, g, p, exchange);
             }
           break;
 
@@ -541,7 +564,7 @@ namespace mpm
           velocity_from_momentum(backend, g, s.mass_tolerance);
           grid_to_particle_kinematics<dim, Shape>(backend, g, p, materials, s, dt, false, true);
           if (s.pressure_averaging)
-            average_cell_pressure(backend, g, p);
+            average_cell_pressure(backend, g, p, exchange);
           particles_to_grid<dim, Shape>(backend, g, p, s, false, true);
           exchange.sum_nodal(forces, dim);
           update_grid(backend, g, s, dt);

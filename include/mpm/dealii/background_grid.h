@@ -60,6 +60,12 @@ namespace mpm
       {
         grid->sum_nodal(arrays, count);
       }
+      // Per-cell sums (pressure averaging) on arrays over lattice cells.
+      template <typename Real>
+      void sum_cells(Real *const *arrays, const int count) const
+      {
+        grid->sum_cells(arrays, count);
+      }
     };
     Exchange exchange() const { return Exchange{this}; }
 
@@ -85,9 +91,29 @@ namespace mpm
     // Nodal fields; their local storage (owned, then ghosts) is the core's node array.
     Vector mass, momentum[dim], force[dim], velocity[dim];
 
+    // The triangulation's partitioner of global active cell indices: locally owned
+    // cells, then the ghost cells (the one layer around them, corners included).
+    std::shared_ptr<const dealii::Utilities::MPI::Partitioner> cell_partitioner;
+
   private:
     template <typename Real>
     void sum_nodal(Real *const *arrays, int count) const;
+
+    // Sums per-cell values over ranks, as sum_nodal does for nodes, over the cell
+    // partitioner: arrays are indexed by lattice cell; the owned and ghost cells' entries
+    // are summed over the ranks that hold them (each rank's own points near a partition
+    // boundary add into ghost cells), every other entry is left as it is.
+    template <typename Real>
+    void sum_cells(Real *const *arrays, int count) const;
+
+    // The Partitioner's add-then-copy-back exchange on count arrays laid out as its
+    // local storage (owned entries, then ghosts).
+    template <typename Real>
+    void exchange_add(const dealii::Utilities::MPI::Partitioner &partitioner, Real *const *arrays,
+                      int count) const;
+
+    // Lattice cell index of each owned and ghost cell, in the cell partitioner's local order.
+    std::vector<long> lattice_cell_of_local_cell;
 
     std::array<BoundaryType, 6> boundary;
     std::vector<int>          lattice_to_node;
@@ -95,8 +121,8 @@ namespace mpm
     std::vector<typename dealii::Triangulation<dim>::active_cell_iterator> cell_of_lattice_cell;
 
     // Scratch of the exchange: import/export buffers and MPI requests per array.
-    mutable std::vector<double>                   buffer_double;
-    mutable std::vector<float>                    buffer_float;
+    mutable std::vector<double>                   buffer_double, cell_buffer_double;
+    mutable std::vector<float>                    buffer_float, cell_buffer_float;
     mutable std::vector<std::vector<MPI_Request>> requests;
   };
 } // namespace mpm

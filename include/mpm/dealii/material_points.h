@@ -12,6 +12,8 @@
 
 #include <boost/signals2/connection.hpp>
 
+#include <memory>
+
 #include <string>
 #include <vector>
 
@@ -40,6 +42,30 @@ namespace mpm
     static std::vector<dealii::DataComponentInterpretation::DataComponentInterpretation> interpretations();
   };
 
+  // What the core's arrays do not hold but output needs, per point in the engine's
+  // order: the particle id and the initial position. Taken from the handler at each
+  // load (the engine's order changes only there).
+  template <int dim>
+  struct PointLabels
+  {
+    std::vector<dealii::types::particle_index> id;
+    std::vector<double>                        initial_position[dim];
+  };
+
+  // A copy of the points as the engine holds them at one time, for output without a
+  // hand-over to the ParticleHandler: the core's arrays (points that left the grid have
+  // material < 0 and are skipped) and their labels.
+  template <int dim>
+  struct PointSnapshot
+  {
+    HostPoints<dim, double>                  points;
+    std::shared_ptr<const PointLabels<dim>> labels;
+
+    // Property array of point i in the handler's layout (PropertyLayout): the values the
+    // handler would hold after a hand-over.
+    void properties(int i, double *values) const;
+  };
+
   template <int dim>
   class MaterialPoints
   {
@@ -52,8 +78,10 @@ namespace mpm
     void generate(const Parameters &parameters);
 
     // Handler -> core arrays (after generation and after every re-sort). If home_cells
-    // is given, it receives the lattice index of each point's (locally owned) cell.
-    void copy_to(HostPoints<dim, double> &points, std::vector<long> *home_cells = nullptr) const;
+    // is given, it receives the lattice index of each point's (locally owned) cell; if
+    // labels is given, each point's id and initial position.
+    void copy_to(HostPoints<dim, double> &points, std::vector<long> *home_cells = nullptr,
+                 PointLabels<dim> *labels = nullptr) const;
 
     // Core arrays -> handler: positions and properties; points the core marked as
     // having left the grid are removed. Then the handler re-sorts points into cells

@@ -1,29 +1,76 @@
 // Field output (grid nodes and material points as .vtu/.pvtu with .pvd time series)
 // and the time history (history.csv), written once in parallel.
+//
+// The particle files are written from a snapshot of the engine's arrays (Engine::snapshot),
+// not from the ParticleHandler: no hand-over, no re-sort per output. Their content is what
+// deal.II's Particles::DataOut writes for the handler (same names, components, values;
+// tests/dealii/test_output_paths.cc asserts it). What the files show is copied when the output
+// is asked for (the snapshot, the nodal vectors); building the patches, compressing and
+// writing can then run on two background threads (grid, particles) while the steps go on
+// (Output/Write in background). The DoFHandler is read there as it is: a repartition must
+// call finish() first.
 #pragma once
 
 #include <mpm/core/diagnostics.h>
 #include <mpm/dealii/background_grid.h>
 #include <mpm/dealii/material_points.h>
 
+#include <deal.II/base/data_out_base.h>
+
+#include <atomic>
 #include <fstream>
+#include <future>
 #include <string>
 #include <utility>
 #include <vector>
 
 namespace mpm
 {
+  // deal.II's Particles::DataOut layout from a snapshot: one patch per point (points that
+  // left the grid skipped), data "id" then every property of PropertyLayout by name, with
+  // the same vector ranges.
+  template <int dim>
+  class PointDataOut : public dealii::DataOutInterface<0, dim>
+  {
+  public:
+    // Patches of the snapshot's points begin .. end - 1 (end < 0: to the last point).
+    void build_patches(const PointSnapshot<dim> &snapshot, int begin = 0, int end = -1);
+
+  protected:
+    const std::vector<dealii::DataOutBase::Patch<0, dim>> &get_patches() const override { return patches; }
+    std::vector<std::string>                               get_dataset_names() const override;
+    std::vector<std::tuple<unsigned int, unsigned int, std::string,
+                           dealii::DataComponentInterpretation::DataComponentInterpretation>>
+    get_nonscalar_data_ranges() const override;
+
+  private:
+    std::vector<dealii::DataOutBase::Patch<0, dim>> patches;
+  };
+
   template <int dim>
   class OutputWriter
   {
   public:
     OutputWriter(const Parameters &parameters, MPI_Comm communicator);
+    // Waits for a write in flight; an error there is reported by finish(), not here.
+    ~OutputWriter();
 
-    // Writes grid and particle files for time t and updates the .pvd records (rank 0
-    // writes the .pvtu and .pvd records, every rank its own .vtu piece). With Output/Write
-    // particle table, also particle_table_NNNNN.R.csv per rank R: id, position and every
-    // property in full precision (the .vtu files hold single precision).
-    void write_fields(double time, BackgroundGrid<dim> &grid, const MaterialPoints<dim> &points);
+    // The snapshot the next write_fields() writes: fill it (Engine::snapshot) right
+    // before. Waits for the write in flight that still reads it.
+    PointSnapshot<dim> &next_snapshot();
+
+    // Writes grid and particle files for time t (rank 0 writes the .pvtu and .pvd records,
+    // every rank its own .vtu pieces: Output/Files per rank, written on as many threads)
+    // from the grid's nodal vectors and next_snapshot().
+    // With Output/Write particle table, also particle_table_NNNNN.R.csv per rank R: id,
+    // position and every property in full precision (the .vtu files hold single
+    // precision). Copies the nodal vectors (with their ghosts: MPI) before returning; the
+    // rest may still be running on background threads when it returns.
+    void write_fields(double time, BackgroundGrid<dim> &grid);
+
+    // Waits for the writes in flight and rethrows their error, if any. Call it before the
+    // triangulation or the DoFHandler change (repartition).
+    void finish();
 
     struct HistoryRow
     {
@@ -38,12 +85,26 @@ namespace mpm
 
     const std::string &directory() const { return output_directory; }
 
+    // Outputs written so far, seconds spent in the write tasks (building patches,
+    // compressing, writing; summed over tasks, on background threads where they ran
+    // there) and seconds the run waited for them in finish().
+    unsigned int n_outputs() const { return counter; }
+    double       task_seconds() const { return 1e-9 * task_nanoseconds; }
+    double       waited_seconds() const { return waited; }
+
   private:
-    MPI_Comm    communicator;
-    std::string output_directory;
-    bool        write_grid, write_particles, write_table;
-    unsigned int counter = 0;
+    MPI_Comm                          communicator;
+    unsigned int                      rank, n_ranks;
+    std::string                       output_directory;
+    bool                              write_grid, write_particles, write_table, background;
+    unsigned int                      pieces_per_rank; // .vtu files per rank and output
+    dealii::DataOutBase::VtkFlags     vtk_flags;
+    unsigned int                      counter = 0;
     std::vector<std::pair<double, std::string>> grid_records, particle_records;
-    std::ofstream history;
+    std::ofstream                     history;
+    PointSnapshot<dim>                snapshot;
+    std::vector<std::future<void>>    in_flight; // grid and particle tasks
+    std::atomic<long long>            task_nanoseconds{0};
+    double                            waited = 0;
   };
 } // namespace mpm

@@ -79,6 +79,9 @@ namespace mpm
     unsigned int history_every;
     double       progress_interval;
     bool         write_particle_table;
+    std::string  output_compression;   // zlib level of the .vtu files: "best speed", ...
+    bool         output_in_background; // compress and write files on a background thread
+    unsigned int output_files_per_rank; // .vtu pieces per rank and output, written in parallel
 
     // Parallel runs (doc/performance.md, MPI)
     double resort_distance;        // re-sort at this fraction of the safe distance outside a home cell

@@ -1,0 +1,176 @@
+// The particle output written from the engine's arrays (PointSnapshot + PointDataOut,
+// output_writer.h) is the same file as deal.II's Particles::DataOut writes from the
+// ParticleHandler after a hand-over, byte for byte (date line off), in 2D and 3D:
+//  - every property set to a distinct value per point and property (so that a swapped
+//    or missing property in PointSnapshot::properties changes the file);
+//  - a point that left the grid (material < 0 in the engine) is missing from the patches,
+//    as it is from the handler after the hand-over removes it (same patches by id);
+//  - the .pvtu records are the same;
+//  - pieces of consecutive point ranges (Output/Files per rank) add up to the whole, and an
+//    empty piece is a valid file.
+// Runs on any number of MPI ranks (each rank compares its own piece).
+#include <mpm/dealii/material_points.h>
+#include <mpm/dealii/output_writer.h>
+
+#include <deal.II/base/mpi.h>
+#include <deal.II/particles/data_out.h>
+
+#include "../core/check.h"
+
+#include <algorithm>
+#include <sstream>
+
+namespace
+{
+  using namespace mpm;
+
+  // Makes get_patches() public.
+  template <typename DataOut>
+  struct Exposed : DataOut
+  {
+    using DataOut::get_patches;
+  };
+
+  // The patches sorted by their first data component, the particle id.
+  template <typename Patch>
+  std::vector<const Patch *> by_id(const std::vector<Patch> &patches)
+  {
+    std::vector<const Patch *> sorted;
+    for (const auto &patch : patches)
+      sorted.push_back(&patch);
+    std::sort(sorted.begin(), sorted.end(), [](const Patch *a, const Patch *b) { return a->data(0, 0) < b->data(0, 0); });
+    return sorted;
+  }
+
+  template <int dim>
+  Parameters scene()
+  {
+    Parameters p;
+    p.dim       = dim;
+    p.lower     = std::vector<double>(dim, 0.0);
+    p.upper     = std::vector<double>(dim, 0.08);
+    p.cell_size = 0.01;
+    p.boundary.fill(BoundaryType::free);
+    BodyParameters body;
+    body.shape                = "box";
+    body.lower                = std::vector<double>(dim, 0.01);
+    body.upper                = std::vector<double>(dim, 0.05);
+    body.points_per_direction = 2;
+    body.density              = 2000;
+    body.velocity             = std::vector<double>(dim, 0.0);
+    body.initial_stress       = "none";
+    body.k0                   = 0.5;
+    p.bodies                  = {body};
+    p.body_material           = {0};
+    p.materials.resize(1);
+    p.material_fields.resize(1);
+    p.point_weight = 20;
+    p.gravity      = std::vector<double>(dim, 0.0);
+    return p;
+  }
+
+  template <int patch_dim, int spacedim>
+  std::string vtu(dealii::DataOutInterface<patch_dim, spacedim> &out)
+  {
+    dealii::DataOutBase::VtkFlags flags;
+    flags.print_date_and_time = false;
+    flags.compression_level   = dealii::DataOutBase::VtkFlags::best_speed;
+    out.set_flags(flags);
+    std::ostringstream s;
+    out.write_vtu(s);
+    return s.str();
+  }
+
+  template <int patch_dim, int spacedim>
+  std::string pvtu(dealii::DataOutInterface<patch_dim, spacedim> &out)
+  {
+    std::ostringstream s;
+    out.write_pvtu_record(s, {"particles_00000.0.vtu"});
+    return s.str();
+  }
+
+  template <int dim>
+  void check_dim()
+  {
+    const Parameters    parameters = scene<dim>();
+    BackgroundGrid<dim> grid(parameters, MPI_COMM_WORLD);
+    MaterialPoints<dim> points(grid, parameters);
+    points.generate(parameters);
+    using Layout = PropertyLayout<dim>;
+
+    // Distinct values: point id and property index both show in each value; the
+    // material id stays an integer (the engine holds it as int).
+    for (auto &particle : points.handler)
+      {
+        auto properties = particle.get_properties();
+        for (unsigned int k = 0; k < Layout::n_properties; ++k)
+          properties[k] = 1000.0 * (k + 1) + 0.37 * particle.get_id() + 1e-3 * k * k;
+        properties[Layout::material] = 3;
+      }
+
+    // Old path: the handler through Particles::DataOut.
+    dealii::Particles::DataOut<dim> from_handler;
+    from_handler.build_patches(points.handler, Layout::names(), Layout::interpretations());
+    // New path: the core's arrays (as the engine loads them) through PointDataOut.
+    PointSnapshot<dim> snapshot;
+    auto               labels = std::make_shared<PointLabels<dim>>();
+    points.copy_to(snapshot.points, nullptr, labels.get());
+    snapshot.labels = labels;
+    PointDataOut<dim> from_snapshot;
+    from_snapshot.build_patches(snapshot);
+
+    const std::string a = vtu(from_handler), b = vtu(from_snapshot);
+    mpm_test::check(points.handler.n_locally_owned_particles() > 10, "the scene has points on this rank");
+    mpm_test::check(a == b, dim == 2 ? "2D: same .vtu from the handler and from the snapshot" :
+                                       "3D: same .vtu from the handler and from the snapshot");
+    mpm_test::check(pvtu(from_handler) == pvtu(from_snapshot), "same .pvtu record");
+
+    // Pieces (Output/Files per rank): consecutive ranges of points give the same patches in
+    // the same order; an empty piece is a valid file without points.
+    {
+      const int                  n = snapshot.points.size();
+      Exposed<PointDataOut<dim>> whole, first, second, empty;
+      whole.build_patches(snapshot);
+      first.build_patches(snapshot, 0, n / 3);
+      second.build_patches(snapshot, n / 3, n);
+      empty.build_patches(snapshot, n, n);
+      bool same = first.get_patches().size() + second.get_patches().size() == whole.get_patches().size();
+      for (unsigned int i = 0; same && i < whole.get_patches().size(); ++i)
+        {
+          const auto &piece = i < first.get_patches().size() ? first.get_patches()[i] :
+                                                               second.get_patches()[i - first.get_patches().size()];
+          same = piece.vertices[0] == whole.get_patches()[i].vertices[0] && piece.data == whole.get_patches()[i].data;
+        }
+      mpm_test::check(same, "two pieces hold the points of the whole, in order");
+      const std::string file = vtu(empty);
+      mpm_test::check(file.find("NumberOfPoints=\"0\"") != std::string::npos, "an empty piece is a file without points");
+    }
+
+    // A point that left the grid: marked in the engine's arrays, removed from the handler
+    // (which reorders the points of that cell): the same patches, matched by id.
+    const int gone = snapshot.points.size() / 2;
+    snapshot.points.material[gone] = -1;
+    auto it = points.handler.begin();
+    std::advance(it, gone);
+    points.handler.remove_particle(it);
+    Exposed<dealii::Particles::DataOut<dim>> from_handler_after;
+    from_handler_after.build_patches(points.handler, Layout::names(), Layout::interpretations());
+    Exposed<PointDataOut<dim>> from_snapshot_after;
+    from_snapshot_after.build_patches(snapshot);
+    const auto old_patches = by_id(from_handler_after.get_patches());
+    const auto new_patches = by_id(from_snapshot_after.get_patches());
+    mpm_test::check(new_patches.size() + 1 == snapshot.points.size(), "a point that left the grid is left out");
+    bool same = old_patches.size() == new_patches.size();
+    for (unsigned int i = 0; same && i < old_patches.size(); ++i)
+      same = old_patches[i]->vertices[0] == new_patches[i]->vertices[0] && old_patches[i]->data == new_patches[i]->data;
+    mpm_test::check(same, "after a point left the grid: the same points and values as the handler's");
+  }
+} // namespace
+
+int main(int argc, char **argv)
+{
+  dealii::Utilities::MPI::MPI_InitFinalize mpi(argc, argv, 1);
+  check_dim<2>();
+  check_dim<3>();
+  return mpm_test::finish("test_output_paths");
+}
