@@ -52,7 +52,11 @@ def measure_3d(data, wall, base, width, fit_low, fit_high, threshold, min_thickn
     y_lo, y_hi = y.min(), y.max()
     mid = 0.5 * (y_lo + y_hi)
     args = (wall, base, width, fit_low, fit_high, threshold, min_thickness)
-    mid_result = deposit.measure(slab(data, np.abs(y - mid) <= 0.5 * width + 1e-12), *args)
+    distance = np.abs(y - mid)
+    near_mid = distance <= 0.5 * width + 1e-12
+    if not near_mid.any():  # the points' spacing is wider than the slab: take the layer nearest the middle
+        near_mid = distance <= distance.min() + 1e-12
+    mid_result = deposit.measure(slab(data, near_mid), *args)
     k = np.floor((y - y_lo) / width + 1e-9).astype(int)
     slabs = [slab_numbers(deposit.measure(slab(data, k == j), *args)) for j in np.unique(k)]
     across = {}
