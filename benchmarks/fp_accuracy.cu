@@ -16,6 +16,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <type_traits>
 #include <vector>
 
 namespace
@@ -26,30 +27,12 @@ namespace
   HostPoints<dim, To> convert(const HostPoints<dim, From> &p)
   {
     HostPoints<dim, To> q;
-    q.resize(p.size());
-    auto cp = [](std::vector<To> &a, const std::vector<From> &b) {
-      for (size_t i = 0; i < b.size(); ++i)
-        a[i] = To(b[i]);
-    };
-    for (int d = 0; d < dim; ++d)
-      {
-        cp(q.position[d], p.position[d]);
-        cp(q.velocity[d], p.velocity[d]);
-        cp(q.domain_half_length[d], p.domain_half_length[d]);
-        cp(q.initial_domain_half_length[d], p.initial_domain_half_length[d]);
-      }
-    for (int c = 0; c < n_voigt; ++c)
-      {
-        cp(q.stress[c], p.stress[c]);
-        cp(q.strain[c], p.strain[c]);
-      }
-    for (int c = 0; c < dim * dim; ++c)
-      cp(q.deformation_gradient[c], p.deformation_gradient[c]);
-    cp(q.mass, p.mass);
-    cp(q.volume, p.volume);
-    cp(q.initial_volume, p.initial_volume);
-    cp(q.plastic_strain, p.plastic_strain);
-    q.material = p.material;
+    for_each_point_array<dim>(q, p, [](auto &to, const auto &from) {
+      using T = typename std::decay_t<decltype(to)>::value_type;
+      to.resize(from.size());
+      for (size_t i = 0; i < from.size(); ++i)
+        to[i] = static_cast<T>(from[i]);
+    });
     return q;
   }
 
