@@ -249,14 +249,8 @@ def main():
         with open(args.json, "w") as f:
             json.dump({k: v for k, v in r.items() if not k.startswith("_")}, f, indent=1)
 
-    failed = False
-    for name, value, lim in (("toe", r["toe"], args.toe), ("top-left height", r["top_left_height"], args.top_left),
-                             ("slope", sl["angle_deg"], args.slope)):
-        if lim is None:
-            continue
-        ok = lim[0] <= value <= lim[1]
-        print(f"  check {name}: {value:.4f} in [{lim[0]:g}, {lim[1]:g}]: {'ok' if ok else 'FAILED'}")
-        failed |= not ok
+    failed = mpm_results.check_limits((("toe", r["toe"], args.toe), ("top-left height", r["top_left_height"], args.top_left),
+                                       ("slope", sl["angle_deg"], args.slope)))
     sys.exit(1 if failed else 0)
 
 

@@ -15,7 +15,6 @@ applies to the mid-plane value and to the mean across the width.
 """
 import argparse
 import json
-import math
 import os
 import sys
 
@@ -105,15 +104,11 @@ def main():
         with open(args.json, "w") as f:
             json.dump({k: v for k, v in r.items() if not k.startswith("_")}, f, indent=1)
 
-    failed = False
-    for name, key, lim in (("toe", "toe", args.toe), ("top-left height", "top_left_height", args.top_left),
-                           ("slope", "slope_deg", args.slope)):
-        if lim is None:
-            continue
-        for where, value in (("mid-plane", m[key]), ("mean across the width", a[key]["mean"])):
-            ok = math.isfinite(value) and lim[0] <= value <= lim[1]
-            print(f"  check {name} ({where}): {value:.4f} in [{lim[0]:g}, {lim[1]:g}]: {'ok' if ok else 'FAILED'}")
-            failed |= not ok
+    failed = mpm_results.check_limits(
+        (f"{name} ({where})", value, lim)
+        for name, key, lim in (("toe", "toe", args.toe), ("top-left height", "top_left_height", args.top_left),
+                               ("slope", "slope_deg", args.slope))
+        for where, value in (("mid-plane", m[key]), ("mean across the width", a[key]["mean"])))
     sys.exit(1 if failed else 0)
 
 

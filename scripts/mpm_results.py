@@ -1,6 +1,7 @@
 """Read dealii-mpm output: the time series of particles (.pvd -> .pvtu -> .vtu pieces)
 and the time history (history.csv). Needs Debian's python3-numpy and python3-meshio."""
 import csv
+import math
 import os
 import xml.etree.ElementTree as ET
 
@@ -42,3 +43,16 @@ def history(output_dir):
     with open(os.path.join(output_dir, "history.csv")) as f:
         rows = list(csv.DictReader(f))
     return {key: np.array([float(r[key]) for r in rows]) for key in rows[0]}
+
+
+def check_limits(checks, digits=4):
+    """Prints one line per (name, value, (low, high) or None) and returns True if a value is outside its
+    limits or not finite; checks without limits are skipped. For the scripts' --option LO,HI checks."""
+    failed = False
+    for name, value, lim in checks:
+        if lim is None:
+            continue
+        ok = math.isfinite(value) and lim[0] <= value <= lim[1]
+        print(f"  check {name}: {value:.{digits}g} in [{lim[0]:g}, {lim[1]:g}]: {'ok' if ok else 'FAILED'}")
+        failed |= not ok
+    return failed

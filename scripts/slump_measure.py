@@ -152,19 +152,13 @@ def main():
         with open(args.json, "w") as f:
             json.dump({k: v for k, v in r.items() if not k.startswith("_")}, f, indent=1)
 
-    failed = False
-    for name, value, lim in (("fraction displaced", r["fraction_displaced"], args.fraction),
-                             ("crown x", r["crown_x"], args.crown),
-                             ("failure depth", r["max_failure_depth"], args.depth),
-                             ("run-out", r.get("run_out", float("nan")), args.run_out),
-                             ("crest drop", r["crest_drop"], args.crest_drop),
-                             ("back displacement", r["back_max_displacement"],
-                              None if args.back_max is None else (0.0, args.back_max))):
-        if lim is None:
-            continue
-        ok = lim[0] <= value <= lim[1]
-        print(f"  check {name}: {value:.4g} in [{lim[0]:g}, {lim[1]:g}]: {'ok' if ok else 'FAILED'}")
-        failed |= not ok
+    failed = mpm_results.check_limits((("fraction displaced", r["fraction_displaced"], args.fraction),
+                                       ("crown x", r["crown_x"], args.crown),
+                                       ("failure depth", r["max_failure_depth"], args.depth),
+                                       ("run-out", r.get("run_out", float("nan")), args.run_out),
+                                       ("crest drop", r["crest_drop"], args.crest_drop),
+                                       ("back displacement", r["back_max_displacement"],
+                                        None if args.back_max is None else (0.0, args.back_max))))
     sys.exit(1 if failed else 0)
 
 
