@@ -82,9 +82,10 @@ namespace mpm
   {
     // For colouring backends: group the points by the first lattice layer of their
     // stencil along the longest grid axis, before the scatters of a point
-    // configuration (again whenever the points have moved). A point's scatters write
-    // nodes of layers [first, first + n_per_direction - 1] and its own cell, which lies
-    // in that range too. Other backends (CUDA: atomics) need nothing.
+    // configuration (again whenever the points have moved; the CPU backend keeps its
+    // slabs while every point stays within their margin, checked each time). A point's
+    // scatters write nodes of layers [first, first + n_per_direction - 1] and its own
+    // cell, which lies in that range too. Other backends (CUDA: atomics) need nothing.
     template <int dim, typename Shape, typename Real, typename Backend>
     void group_for_scatter(Backend &backend, const GridView<dim, Real> &g, const PointsView<dim, Real> &p)
     {
@@ -550,7 +551,7 @@ namespace mpm
           break;
       }
     if constexpr (colours_scatter<Backend>::value)
-      backend.ungroup(); // the points have moved: a later scatter must not trust the grouping
+      backend.ungroup(); // the points have moved: the next group_for_scatter checks the grouping again
     return reduce_step(backend, p, s);
   }
 
