@@ -95,15 +95,26 @@ namespace mpm
           for (int d = 1; d < dim; ++d)
             if (g.n_cells[d] > g.n_cells[axis])
               axis = d;
-          constexpr int n = Shape::n_per_direction;
-          backend.group_points(p.n_points, g.n_cells[axis] + 1, n, [&](const int i) {
+          // The key is the lowest layer the point writes: its stencil's first node, computed
+          // with the stencil's own arithmetic (for_each_stencil_node), or its cell (pressure
+          // averaging: GridView::lattice_cell's arithmetic) where round-off at a cell face
+          // puts that one lower. GIMP: the cell always lies in [first, first + 2] (s is at
+          // least half a cell above the first node), so the key is first and the span 3.
+          // Linear: the cell can be first - 1 at a face, so the span is 3, not 2.
+          constexpr int n    = Shape::n_per_direction;
+          constexpr int span = n == 2 ? 3 : n;
+          const Real    inv_h = Real(1) / g.h;
+          backend.group_points(p.n_points, g.n_cells[axis] + 1, span, [&](const int i) {
             if (p.material[i] < 0)
               return -1;
-            int  first;
-            Real w[n], dw[n];
-            Shape::weights_1d((p.position[axis][i] - g.origin[axis]) / g.h, p.domain_half_length[axis][i] / g.h,
-                              first, w, dw);
-            return first < 0 ? 0 : first;
+            int        first;
+            Real       w[n], dw[n];
+            const Real x = p.position[axis][i];
+            Shape::weights_1d((x - g.origin[axis]) * inv_h, p.domain_half_length[axis][i] * inv_h, first, w, dw);
+            int cell = static_cast<int>(std::floor((x - g.origin[axis]) / g.h));
+            cell     = cell < 0 ? 0 : (cell >= g.n_cells[axis] ? g.n_cells[axis] - 1 : cell);
+            const int key = first < cell ? first : cell;
+            return key < 0 ? 0 : key;
           });
         }
     }
@@ -219,14 +230,15 @@ namespace mpm
     }
 
     // G2P velocity of point i: FLIP v_p + dt sum N a_i, blended with PIC sum N v_i^{n+1}.
-    template <int dim, typename Shape, typename Real>
+    // stencil(visit) visits the point's stencil nodes (for_each_stencil_node).
+    template <int dim, typename Real, typename Stencil>
     MPM_HOST_DEVICE inline void updated_point_velocity(const GridView<dim, Real> &g, const PointsView<dim, Real> &p,
                                                        const StepSettings<dim, Real> &s, const Real dt, const int i,
-                                                       const Real x[dim], const Real lp[dim], Real v_new[dim])
+                                                       Stencil &&stencil, Real v_new[dim])
     {
       Real       a[dim] = {}, v_pic[dim] = {};
       const bool pic    = s.flip_fraction != Real(1); // pure FLIP reads no nodal velocity
-      for_each_stencil_node<dim, Shape>(g, x, lp, [&](const int n, const Real N, const Real *) {
+      stencil([&](const int n, const Real N, const Real *) {
         for (int d = 0; d < dim; ++d)
           a[d] += N * g.force[d][n];
         if (pic)
@@ -255,7 +267,8 @@ namespace mpm
             x[d]  = p.position[d][i];
             lp[d] = p.domain_half_length[d][i];
           }
-        updated_point_velocity<dim, Shape>(g, p, s, dt, i, x, lp, v_new);
+        updated_point_velocity<dim>(
+          g, p, s, dt, i, [&](auto &&visit) { for_each_stencil_node<dim, Shape>(g, x, lp, visit); }, v_new);
         for (int d = 0; d < dim; ++d)
           p.velocity[d][i] = v_new[d];
       });
@@ -283,7 +296,15 @@ namespace mpm
             x[d]  = p.position[d][i];
             lp[d] = p.domain_half_length[d][i];
           }
-        updated_point_velocity<dim, Shape>(g, p, s, dt, i, x, lp, v_new);
+#if defined(__CUDA_ARCH__) || defined(MPM_UNROLL_STENCIL)
+        auto stencil = [&](auto &&visit) { for_each_stencil_node<dim, Shape>(g, x, lp, visit); };
+#else
+        // Host: the stencil's weights evaluated once for the gather and the scatter (the
+        // same values as two for_each_stencil_node calls).
+        const HostStencil<dim, Shape, Real> host_stencil(g, x, lp);
+        auto stencil = [&](auto &&visit) { host_stencil.for_each(g, visit); };
+#endif
+        updated_point_velocity<dim>(g, p, s, dt, i, stencil, v_new);
         const Real m = p.mass[i];
         for (int d = 0; d < dim; ++d)
           {
@@ -293,7 +314,7 @@ namespace mpm
         Real *targets[dim];
         for (int d = 0; d < dim; ++d)
           targets[d] = g.momentum[d];
-        for_each_stencil_node<dim, Shape>(g, x, lp, [&](const int n, const Real N, const Real *) {
+        stencil([&](const int n, const Real N, const Real *) {
           Real values[dim];
           for (int d = 0; d < dim; ++d)
             values[d] = N * mv[d];
