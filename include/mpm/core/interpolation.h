@@ -43,6 +43,7 @@ namespace mpm
     Real                 w[dim][n], dw[dim][n];
     Real                 inv_h;
 
+    HostStencil() = default;
     HostStencil(const GridView<dim, Real> &grid, const Real x[dim], const Real half_length[dim])
       : inv_h(Real(1) / grid.h)
     {

@@ -16,6 +16,7 @@
 #include <cmath>
 #include <stdexcept>
 #include <type_traits>
+#include <utility>
 
 namespace mpm
 {
@@ -76,6 +77,16 @@ namespace mpm
   template <typename Backend>
   struct colours_scatter<Backend, std::void_t<decltype(Backend::colours_scatter)>>
     : std::bool_constant<Backend::colours_scatter>
+  {};
+
+  // Host backends that lend per-point scratch memory kept between steps
+  // (CpuBackend::point_scratch(n, bytes per point)).
+  template <typename Backend, typename = void>
+  struct has_point_scratch : std::false_type
+  {};
+  template <typename Backend>
+  struct has_point_scratch<Backend, std::void_t<decltype(std::declval<Backend &>().point_scratch(0, 0))>>
+    : std::true_type
   {};
 
   namespace stages
@@ -140,7 +151,8 @@ namespace mpm
                            const PointsView<dim, Real>      &p,
                            const StepSettings<dim, Real>    &s,
                            const bool                        mass_and_momentum,
-                           const bool                        forces)
+                           const bool                        forces,
+                           void                             *stencils = nullptr)
     {
       backend.scatter_points(p.n_points, [=] MPM_HOST_DEVICE(const int i) {
         if (p.material[i] < 0)
@@ -166,7 +178,7 @@ namespace mpm
             targets[1 + d]       = g.momentum[d];
             targets[1 + dim + d] = g.force[d];
           }
-        for_each_stencil_node<dim, Shape>(g, x, lp, [&](const int n, const Real N, const Real *grad) {
+        auto visit = [&](const int n, const Real N, const Real *grad) {
           Real values[K];
           values[0] = N * m;
           for (int d = 0; d < dim; ++d)
@@ -183,7 +195,16 @@ namespace mpm
             Backend::template add_to_node<dim + 1>(targets, n, values);
           else if (forces)
             Backend::template add_to_node<dim>(targets + dim + 1, n, values + dim + 1);
-        });
+        };
+#if defined(__CUDA_ARCH__) || defined(MPM_UNROLL_STENCIL)
+        for_each_stencil_node<dim, Shape>(g, x, lp, visit);
+#else
+        // Host: the stencil, kept for the later stages of the step where they asked for it.
+        const HostStencil<dim, Shape, Real> stencil(g, x, lp);
+        if (stencils != nullptr)
+          static_cast<HostStencil<dim, Shape, Real> *>(stencils)[i] = stencil;
+        stencil.for_each(g, visit);
+#endif
       });
     }
 
@@ -281,7 +302,7 @@ namespace mpm
     template <int dim, typename Shape, typename Real, typename Backend>
     void grid_to_particle_velocity_and_remap(Backend &backend, const GridView<dim, Real> &g,
                                              const PointsView<dim, Real> &p, const StepSettings<dim, Real> &s,
-                                             const Real dt)
+                                             const Real dt, const void *stencils = nullptr)
     {
       backend.for_each_node(g.n_nodes, [=] MPM_HOST_DEVICE(const int n) {
         for (int d = 0; d < dim; ++d)
@@ -300,9 +321,12 @@ namespace mpm
         auto stencil = [&](auto &&visit) { for_each_stencil_node<dim, Shape>(g, x, lp, visit); };
 #else
         // Host: the stencil's weights evaluated once for the gather and the scatter (the
-        // same values as two for_each_stencil_node calls).
-        const HostStencil<dim, Shape, Real> host_stencil(g, x, lp);
-        auto stencil = [&](auto &&visit) { host_stencil.for_each(g, visit); };
+        // same values as two for_each_stencil_node calls), or those P2G kept.
+        HostStencil<dim, Shape, Real>        own;
+        const HostStencil<dim, Shape, Real> *host_stencil =
+          stencils != nullptr ? static_cast<const HostStencil<dim, Shape, Real> *>(stencils) + i :
+                                (own = HostStencil<dim, Shape, Real>(g, x, lp), &own);
+        auto stencil = [&](auto &&visit) { host_stencil->for_each(g, visit); };
 #endif
         updated_point_velocity<dim>(g, p, s, dt, i, stencil, v_new);
         const Real m = p.mass[i];
@@ -333,7 +357,8 @@ namespace mpm
                                      const PointsView<dim, Real> &p,
                                      const MaterialParameters<Real> *materials,
                                      const StepSettings<dim, Real> &s, const Real dt,
-                                     const bool move_points, const bool deform_points)
+                                     const bool move_points, const bool deform_points,
+                                     const void *stencils = nullptr)
     {
       backend.gather_points(p.n_points, [=] MPM_HOST_DEVICE(const int i) {
         if (p.material[i] < 0)
@@ -345,7 +370,7 @@ namespace mpm
             x[d]  = p.position[d][i];
             lp[d] = p.domain_half_length[d][i];
           }
-        for_each_stencil_node<dim, Shape>(g, x, lp, [&](const int n, const Real N, const Real *grad) {
+        auto visit = [&](const int n, const Real N, const Real *grad) {
           for (int d = 0; d < dim; ++d)
             {
               const Real v = g.velocity[d][n];
@@ -353,7 +378,15 @@ namespace mpm
               for (int e = 0; e < dim; ++e)
                 L.a[d][e] += v * grad[e];
             }
-        });
+        };
+#if defined(__CUDA_ARCH__) || defined(MPM_UNROLL_STENCIL)
+        for_each_stencil_node<dim, Shape>(g, x, lp, visit);
+#else
+        if (stencils != nullptr) // kept by P2G: the points have not moved since
+          static_cast<const HostStencil<dim, Shape, Real> *>(stencils)[i].for_each(g, visit);
+        else
+          HostStencil<dim, Shape, Real>(g, x, lp).for_each(g, visit);
+#endif
 
         if (deform_points)
           {
@@ -525,15 +558,24 @@ namespace mpm
     switch (s.scheme)
       {
         case UpdateScheme::musl:
-          reset_grid(backend, g, true);
-          particles_to_grid<dim, Shape>(backend, g, p, s, true, true);
-          exchange.sum_nodal(mass_and_momentum, dim + 1);
-          exchange.sum_nodal(forces, dim);
-          update_grid(backend, g, s, dt);
-          grid_to_particle_velocity_and_remap<dim, Shape>(backend, g, p, s, dt);
-          exchange.sum_nodal(momentum, dim);
-          velocity_from_momentum(backend, g, s.mass_tolerance);
-          grid_to_particle_kinematics<dim, Shape>(backend, g, p, materials, s, dt, true, true);
+          {
+            // Host backends with point scratch: P2G keeps each point's stencil for the
+            // remap and the kinematics (the points move only at the end of the latter).
+            void *stencils = nullptr;
+#if !defined(__CUDA_ARCH__) && !defined(MPM_UNROLL_STENCIL)
+            if constexpr (has_point_scratch<Backend>::value)
+              stencils = backend.point_scratch(p.n_points, sizeof(HostStencil<dim, Shape, Real>));
+#endif
+            reset_grid(backend, g, true);
+            particles_to_grid<dim, Shape>(backend, g, p, s, true, true, stencils);
+            exchange.sum_nodal(mass_and_momentum, dim + 1);
+            exchange.sum_nodal(forces, dim);
+            update_grid(backend, g, s, dt);
+            grid_to_particle_velocity_and_remap<dim, Shape>(backend, g, p, s, dt, stencils);
+            exchange.sum_nodal(momentum, dim);
+            velocity_from_momentum(backend, g, s.mass_tolerance);
+            grid_to_particle_kinematics<dim, Shape>(backend, g, p, materials, s, dt, true, true, stencils);
+          }
           if (s.pressure_averaging)
             {
               group_for_scatter<dim, Shape>(backend, g, p); // the points have moved

@@ -39,6 +39,7 @@
 
 #include <mpm/core/config.h>
 
+#include <cstddef>
 #include <vector>
 
 #ifdef MPM_WITH_TBB
@@ -148,6 +149,17 @@ namespace mpm
       grouped_points = -1;
     }
 
+    // Scratch memory for n points of `bytes` each (8-byte aligned), kept between calls so
+    // that the step allocates nothing once it has run (step.h: P2G keeps the points'
+    // stencils there for the remap and the kinematics of the same step).
+    void *point_scratch(const std::size_t n, const std::size_t bytes)
+    {
+      const std::size_t words = (n * bytes + sizeof(double) - 1) / sizeof(double);
+      if (scratch.size() < words)
+        scratch.resize(words);
+      return scratch.data();
+    }
+
     // How often group_points built the slabs and how often it kept them (for benchmarks).
     long n_built = 0, n_reused = 0;
 
@@ -207,6 +219,7 @@ namespace mpm
     int              grouped_points = -1, grouped_layers = -1, grouped_span = -1;
     bool             checked        = false; // the slabs hold for the current point configuration
     std::vector<int> slab_of, slab_start, fill, order;
+    std::vector<double> scratch; // point_scratch
 
     template <typename F>
     static void parallel(const int n, F &f)
