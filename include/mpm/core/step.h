@@ -196,6 +196,7 @@ namespace mpm
           else if (forces)
             Backend::template add_to_node<dim>(targets + dim + 1, n, values + dim + 1);
         };
+        (void)stencils; // captured in both compilation passes (nvcc's extended lambdas need the same captures)
 #if defined(__CUDA_ARCH__) || defined(MPM_UNROLL_STENCIL)
         for_each_stencil_node<dim, Shape>(g, x, lp, visit);
 #else
@@ -317,6 +318,7 @@ namespace mpm
             x[d]  = p.position[d][i];
             lp[d] = p.domain_half_length[d][i];
           }
+        (void)stencils; // captured in both compilation passes (nvcc's extended lambdas need the same captures)
 #if defined(__CUDA_ARCH__) || defined(MPM_UNROLL_STENCIL)
         auto stencil = [&](auto &&visit) { for_each_stencil_node<dim, Shape>(g, x, lp, visit); };
 #else
@@ -379,6 +381,7 @@ namespace mpm
                 L.a[d][e] += v * grad[e];
             }
         };
+        (void)stencils; // captured in both compilation passes (nvcc's extended lambdas need the same captures)
 #if defined(__CUDA_ARCH__) || defined(MPM_UNROLL_STENCIL)
         for_each_stencil_node<dim, Shape>(g, x, lp, visit);
 #else
