@@ -30,6 +30,8 @@ int main()
 
       // random axis and rate
       double w[3] = {u(rng), u(rng), u(rng)};
+      if (trial % 4 == 0) // spin about z only: rotate_jaumann's closed form for the plane case
+        w[0] = w[1] = 0;
       const double norm = std::sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
       for (double &c : w)
         c /= norm;

@@ -3,7 +3,9 @@
 //
 // Two forms of the stencil loop, the same nodes in the same order:
 // - the default: one rolled loop over the stencil positions, with run-time indices into
-//   the 1D weights and the lattice bounds checked per node;
+//   the 1D weights and the lattice bounds checked per node; on the host (not in device
+//   code) the node indices come from a base index plus strides, bounds checked once per
+//   point, with the same weights bit for bit;
 // - -DMPM_UNROLL_STENCIL: loops nested per direction with compile-time bounds, unrolled
 //   on the device, so that the weights stay in registers and every index into them is a
 //   constant, the products of the outer directions' weights formed once per row, and,
@@ -25,12 +27,96 @@
 
 namespace mpm
 {
+#if !defined(__CUDA_ARCH__)
+  // Host: one point's stencil, its 1D weights evaluated once (bit for bit as
+  // for_each_stencil_node's), visited as often as a stage needs (G2P velocity and the
+  // MUSL remap share one). The node's lattice index is the point's base index plus a
+  // constant offset per stencil position; where the whole stencil lies inside the lattice
+  // (nearly every point) the bounds are checked once per point, else per node as
+  // GridView::node does. Same nodes, same order, same arithmetic for N and grad as the
+  // device form.
+  template <int dim, typename Shape, typename Real>
+  struct HostStencil
+  {
+    static constexpr int n = Shape::n_per_direction;
+    int                  first[dim];
+    Real                 w[dim][n], dw[dim][n];
+    Real                 inv_h;
+
+    HostStencil() = default;
+    HostStencil(const GridView<dim, Real> &grid, const Real x[dim], const Real half_length[dim])
+      : inv_h(Real(1) / grid.h)
+    {
+      for (int d = 0; d < dim; ++d)
+        Shape::weights_1d((x[d] - grid.origin[d]) * inv_h, half_length[d] * inv_h, first[d], w[d], dw[d]);
+    }
+
+    template <typename Visitor>
+    void for_each(const GridView<dim, Real> &grid, Visitor &&visit) const
+    {
+      constexpr int n_stencil = dim == 2 ? n * n : n * n * n;
+      long          stride[dim], base = 0;
+      bool          inside = true;
+      for (int d = 0; d < dim; ++d)
+        {
+          stride[d] = d == 0 ? 1 : stride[d - 1] * (grid.n_cells[d - 1] + 1);
+          base += first[d] * stride[d];
+          inside = inside && first[d] >= 0 && first[d] + n - 1 <= grid.n_cells[d];
+        }
+      auto visit_position = [&](const int s, const int node) {
+        const int k[3] = {s % n, (s / n) % n, s / (n * n)};
+        Real      N    = Real(1);
+        for (int d = 0; d < dim; ++d)
+          N *= w[d][k[d]];
+        Real grad[dim];
+        for (int d = 0; d < dim; ++d)
+          {
+            Real g = dw[d][k[d]] * inv_h;
+            for (int e = 0; e < dim; ++e)
+              if (e != d)
+                g *= w[e][k[e]];
+            grad[d] = g;
+          }
+        visit(node, N, grad);
+      };
+      if (inside)
+        {
+          const int *nodes = grid.lattice_to_node + base;
+          for (int s = 0; s < n_stencil; ++s)
+            {
+              const int k[3]   = {s % n, (s / n) % n, s / (n * n)};
+              long      offset = 0;
+              for (int d = 0; d < dim; ++d)
+                offset += k[d] * stride[d];
+              const int node = nodes[offset];
+              if (node >= 0) // absent from this rank's node set
+                visit_position(s, node);
+            }
+        }
+      else
+        for (int s = 0; s < n_stencil; ++s)
+          {
+            const int k[3] = {s % n, (s / n) % n, s / (n * n)};
+            int       idx[dim];
+            for (int d = 0; d < dim; ++d)
+              idx[d] = first[d] + k[d];
+            const int node = grid.node(idx);
+            if (node >= 0) // else outside the lattice: the weight is zero for points inside the grid
+              visit_position(s, node);
+          }
+    }
+  };
+#endif
+
   template <int dim, typename Shape, typename Real, typename Visitor>
   MPM_HOST_DEVICE inline void for_each_stencil_node(const GridView<dim, Real> &grid,
                                                     const Real x[dim],
                                                     const Real half_length[dim],
                                                     Visitor  &&visit)
   {
+#if !defined(MPM_UNROLL_STENCIL) && !defined(__CUDA_ARCH__)
+    HostStencil<dim, Shape, Real>(grid, x, half_length).for_each(grid, visit);
+#else
     constexpr int n = Shape::n_per_direction;
     int           first[dim];
     Real          w[dim][n], dw[dim][n];
@@ -38,7 +124,7 @@ namespace mpm
     for (int d = 0; d < dim; ++d)
       Shape::weights_1d((x[d] - grid.origin[d]) * inv_h, half_length[d] * inv_h, first[d], w[d], dw[d]);
 
-#if !defined(MPM_UNROLL_STENCIL)
+#  if !defined(MPM_UNROLL_STENCIL)
     constexpr int n_stencil = dim == 2 ? n * n : n * n * n;
     for (int s = 0; s < n_stencil; ++s)
       {
@@ -63,7 +149,7 @@ namespace mpm
           }
         visit(node, N, grad);
       }
-#else
+#  else
     // Lattice strides (x fastest, as GridView::node) and the point's base index.
     long stride[dim], base = 0;
     bool inside = true;
@@ -127,6 +213,7 @@ namespace mpm
               visit(node, w[0][kx] * w[1][ky], grad);
             }
       }
+#  endif
 #endif
   }
 } // namespace mpm

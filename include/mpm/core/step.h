@@ -16,6 +16,7 @@
 #include <cmath>
 #include <stdexcept>
 #include <type_traits>
+#include <utility>
 
 namespace mpm
 {
@@ -83,13 +84,24 @@ namespace mpm
     : std::bool_constant<Backend::colours_scatter>
   {};
 
+  // Host backends that lend per-point scratch memory kept between steps
+  // (CpuBackend::point_scratch(n, bytes per point)).
+  template <typename Backend, typename = void>
+  struct has_point_scratch : std::false_type
+  {};
+  template <typename Backend>
+  struct has_point_scratch<Backend, std::void_t<decltype(std::declval<Backend &>().point_scratch(0, 0))>>
+    : std::true_type
+  {};
+
   namespace stages
   {
     // For colouring backends: group the points by the first lattice layer of their
     // stencil along the longest grid axis, before the scatters of a point
-    // configuration (again whenever the points have moved). A point's scatters write
-    // nodes of layers [first, first + n_per_direction - 1] and its own cell, which lies
-    // in that range too. Other backends (CUDA: atomics) need nothing.
+    // configuration (again whenever the points have moved; the CPU backend keeps its
+    // slabs while every point stays within their margin, checked each time). A point's
+    // scatters write nodes of layers [first, first + n_per_direction - 1] and its own
+    // cell, which lies in that range too. Other backends (CUDA: atomics) need nothing.
     template <int dim, typename Shape, typename Real, typename Backend>
     void group_for_scatter(Backend &backend, const GridView<dim, Real> &g, const PointsView<dim, Real> &p)
     {
@@ -99,15 +111,26 @@ namespace mpm
           for (int d = 1; d < dim; ++d)
             if (g.n_cells[d] > g.n_cells[axis])
               axis = d;
-          constexpr int n = Shape::n_per_direction;
-          backend.group_points(p.n_points, g.n_cells[axis] + 1, n, [&](const int i) {
+          // The key is the lowest layer the point writes: its stencil's first node, computed
+          // with the stencil's own arithmetic (for_each_stencil_node), or its cell (pressure
+          // averaging: GridView::lattice_cell's arithmetic) where round-off at a cell face
+          // puts that one lower. GIMP: the cell always lies in [first, first + 2] (s is at
+          // least half a cell above the first node), so the key is first and the span 3.
+          // Linear: the cell can be first - 1 at a face, so the span is 3, not 2.
+          constexpr int n    = Shape::n_per_direction;
+          constexpr int span = n == 2 ? 3 : n;
+          const Real    inv_h = Real(1) / g.h;
+          backend.group_points(p.n_points, g.n_cells[axis] + 1, span, [&](const int i) {
             if (p.material[i] < 0)
               return -1;
-            int  first;
-            Real w[n], dw[n];
-            Shape::weights_1d((p.position[axis][i] - g.origin[axis]) / g.h, p.domain_half_length[axis][i] / g.h,
-                              first, w, dw);
-            return first < 0 ? 0 : first;
+            int        first;
+            Real       w[n], dw[n];
+            const Real x = p.position[axis][i];
+            Shape::weights_1d((x - g.origin[axis]) * inv_h, p.domain_half_length[axis][i] * inv_h, first, w, dw);
+            int cell = static_cast<int>(std::floor((x - g.origin[axis]) / g.h));
+            cell     = cell < 0 ? 0 : (cell >= g.n_cells[axis] ? g.n_cells[axis] - 1 : cell);
+            const int key = first < cell ? first : cell;
+            return key < 0 ? 0 : key;
           });
         }
     }
@@ -133,7 +156,8 @@ namespace mpm
                            const PointsView<dim, Real>      &p,
                            const StepSettings<dim, Real>    &s,
                            const bool                        mass_and_momentum,
-                           const bool                        forces)
+                           const bool                        forces,
+                           void                             *stencils = nullptr)
     {
       backend.scatter_points(p.n_points, [=] MPM_HOST_DEVICE(const int i) {
         if (p.material[i] < 0)
@@ -159,7 +183,7 @@ namespace mpm
             targets[1 + d]       = g.momentum[d];
             targets[1 + dim + d] = g.force[d];
           }
-        for_each_stencil_node<dim, Shape>(g, x, lp, [&](const int n, const Real N, const Real *grad) {
+        auto visit = [&](const int n, const Real N, const Real *grad) {
           Real values[K];
           values[0] = N * m;
           for (int d = 0; d < dim; ++d)
@@ -176,7 +200,17 @@ namespace mpm
             Backend::template add_to_node<dim + 1>(targets, n, values);
           else if (forces)
             Backend::template add_to_node<dim>(targets + dim + 1, n, values + dim + 1);
-        });
+        };
+        (void)stencils; // captured in both compilation passes (nvcc's extended lambdas need the same captures)
+#if defined(__CUDA_ARCH__) || defined(MPM_UNROLL_STENCIL)
+        for_each_stencil_node<dim, Shape>(g, x, lp, visit);
+#else
+        // Host: the stencil, kept for the later stages of the step where they asked for it.
+        const HostStencil<dim, Shape, Real> stencil(g, x, lp);
+        if (stencils != nullptr)
+          static_cast<HostStencil<dim, Shape, Real> *>(stencils)[i] = stencil;
+        stencil.for_each(g, visit);
+#endif
       });
     }
 
@@ -223,14 +257,15 @@ namespace mpm
     }
 
     // G2P velocity of point i: FLIP v_p + dt sum N a_i, blended with PIC sum N v_i^{n+1}.
-    template <int dim, typename Shape, typename Real>
+    // stencil(visit) visits the point's stencil nodes (for_each_stencil_node).
+    template <int dim, typename Real, typename Stencil>
     MPM_HOST_DEVICE inline void updated_point_velocity(const GridView<dim, Real> &g, const PointsView<dim, Real> &p,
                                                        const StepSettings<dim, Real> &s, const Real dt, const int i,
-                                                       const Real x[dim], const Real lp[dim], Real v_new[dim])
+                                                       Stencil &&stencil, Real v_new[dim])
     {
       Real       a[dim] = {}, v_pic[dim] = {};
       const bool pic    = s.flip_fraction != Real(1); // pure FLIP reads no nodal velocity
-      for_each_stencil_node<dim, Shape>(g, x, lp, [&](const int n, const Real N, const Real *) {
+      stencil([&](const int n, const Real N, const Real *) {
         for (int d = 0; d < dim; ++d)
           a[d] += N * g.force[d][n];
         if (pic)
@@ -259,7 +294,8 @@ namespace mpm
             x[d]  = p.position[d][i];
             lp[d] = p.domain_half_length[d][i];
           }
-        updated_point_velocity<dim, Shape>(g, p, s, dt, i, x, lp, v_new);
+        updated_point_velocity<dim>(
+          g, p, s, dt, i, [&](auto &&visit) { for_each_stencil_node<dim, Shape>(g, x, lp, visit); }, v_new);
         for (int d = 0; d < dim; ++d)
           p.velocity[d][i] = v_new[d];
       });
@@ -272,7 +308,7 @@ namespace mpm
     template <int dim, typename Shape, typename Real, typename Backend>
     void grid_to_particle_velocity_and_remap(Backend &backend, const GridView<dim, Real> &g,
                                              const PointsView<dim, Real> &p, const StepSettings<dim, Real> &s,
-                                             const Real dt)
+                                             const Real dt, const void *stencils = nullptr)
     {
       backend.for_each_node(g.n_nodes, [=] MPM_HOST_DEVICE(const int n) {
         for (int d = 0; d < dim; ++d)
@@ -287,7 +323,19 @@ namespace mpm
             x[d]  = p.position[d][i];
             lp[d] = p.domain_half_length[d][i];
           }
-        updated_point_velocity<dim, Shape>(g, p, s, dt, i, x, lp, v_new);
+        (void)stencils; // captured in both compilation passes (nvcc's extended lambdas need the same captures)
+#if defined(__CUDA_ARCH__) || defined(MPM_UNROLL_STENCIL)
+        auto stencil = [&](auto &&visit) { for_each_stencil_node<dim, Shape>(g, x, lp, visit); };
+#else
+        // Host: the stencil's weights evaluated once for the gather and the scatter (the
+        // same values as two for_each_stencil_node calls), or those P2G kept.
+        HostStencil<dim, Shape, Real>        own;
+        const HostStencil<dim, Shape, Real> *host_stencil =
+          stencils != nullptr ? static_cast<const HostStencil<dim, Shape, Real> *>(stencils) + i :
+                                (own = HostStencil<dim, Shape, Real>(g, x, lp), &own);
+        auto stencil = [&](auto &&visit) { host_stencil->for_each(g, visit); };
+#endif
+        updated_point_velocity<dim>(g, p, s, dt, i, stencil, v_new);
         const Real m = p.mass[i];
         for (int d = 0; d < dim; ++d)
           {
@@ -297,7 +345,7 @@ namespace mpm
         Real *targets[dim];
         for (int d = 0; d < dim; ++d)
           targets[d] = g.momentum[d];
-        for_each_stencil_node<dim, Shape>(g, x, lp, [&](const int n, const Real N, const Real *) {
+        stencil([&](const int n, const Real N, const Real *) {
           Real values[dim];
           for (int d = 0; d < dim; ++d)
             values[d] = N * mv[d];
@@ -316,7 +364,8 @@ namespace mpm
                                      const PointsView<dim, Real> &p,
                                      const MaterialParameters<Real> *materials,
                                      const StepSettings<dim, Real> &s, const Real dt,
-                                     const bool move_points, const bool deform_points)
+                                     const bool move_points, const bool deform_points,
+                                     const void *stencils = nullptr)
     {
       backend.gather_points(p.n_points, [=] MPM_HOST_DEVICE(const int i) {
         if (p.material[i] < 0)
@@ -328,7 +377,7 @@ namespace mpm
             x[d]  = p.position[d][i];
             lp[d] = p.domain_half_length[d][i];
           }
-        for_each_stencil_node<dim, Shape>(g, x, lp, [&](const int n, const Real N, const Real *grad) {
+        auto visit = [&](const int n, const Real N, const Real *grad) {
           for (int d = 0; d < dim; ++d)
             {
               const Real v = g.velocity[d][n];
@@ -336,7 +385,16 @@ namespace mpm
               for (int e = 0; e < dim; ++e)
                 L.a[d][e] += v * grad[e];
             }
-        });
+        };
+        (void)stencils; // captured in both compilation passes (nvcc's extended lambdas need the same captures)
+#if defined(__CUDA_ARCH__) || defined(MPM_UNROLL_STENCIL)
+        for_each_stencil_node<dim, Shape>(g, x, lp, visit);
+#else
+        if (stencils != nullptr) // kept by P2G: the points have not moved since
+          static_cast<const HostStencil<dim, Shape, Real> *>(stencils)[i].for_each(g, visit);
+        else
+          HostStencil<dim, Shape, Real>(g, x, lp).for_each(g, visit);
+#endif
 
         if (deform_points)
           {
@@ -526,15 +584,24 @@ namespace mpm
     switch (s.scheme)
       {
         case UpdateScheme::musl:
-          reset_grid(backend, g, true);
-          particles_to_grid<dim, Shape>(backend, g, p, s, true, true);
-          exchange.sum_nodal(mass_and_momentum, dim + 1);
-          exchange.sum_nodal(forces, dim);
-          update_grid(backend, g, s, dt);
-          grid_to_particle_velocity_and_remap<dim, Shape>(backend, g, p, s, dt);
-          exchange.sum_nodal(momentum, dim);
-          velocity_from_momentum(backend, g, s.mass_tolerance);
-          grid_to_particle_kinematics<dim, Shape>(backend, g, p, materials, s, dt, true, true);
+          {
+            // Host backends with point scratch: P2G keeps each point's stencil for the
+            // remap and the kinematics (the points move only at the end of the latter).
+            void *stencils = nullptr;
+#if !defined(__CUDA_ARCH__) && !defined(MPM_UNROLL_STENCIL)
+            if constexpr (has_point_scratch<Backend>::value)
+              stencils = backend.point_scratch(p.n_points, sizeof(HostStencil<dim, Shape, Real>));
+#endif
+            reset_grid(backend, g, true);
+            particles_to_grid<dim, Shape>(backend, g, p, s, true, true, stencils);
+            exchange.sum_nodal(mass_and_momentum, dim + 1);
+            exchange.sum_nodal(forces, dim);
+            update_grid(backend, g, s, dt);
+            grid_to_particle_velocity_and_remap<dim, Shape>(backend, g, p, s, dt, stencils);
+            exchange.sum_nodal(momentum, dim);
+            velocity_from_momentum(backend, g, s.mass_tolerance);
+            grid_to_particle_kinematics<dim, Shape>(backend, g, p, materials, s, dt, true, true, stencils);
+          }
           if (s.pressure_averaging)
             {
               group_for_scatter<dim, Shape>(backend, g, p); // the points have moved
@@ -573,7 +640,7 @@ namespace mpm
           break;
       }
     if constexpr (colours_scatter<Backend>::value)
-      backend.ungroup(); // the points have moved: a later scatter must not trust the grouping
+      backend.ungroup(); // the points have moved: the next group_for_scatter checks the grouping again
     return reduce_step(backend, p, s);
   }
 

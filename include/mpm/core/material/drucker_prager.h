@@ -57,6 +57,46 @@ namespace mpm
     return k;
   }
 
+  // Host only: the coefficients of the strength (c, phi, psi) and cut-off last asked for
+  // by this thread, which are nearly always those of the next point (no softening, one
+  // material): the sines, cosine, divisions and root are then not evaluated again. The
+  // same values bit for bit, computed by the same function.
+  template <typename Real>
+  inline DruckerPragerCoefficients<Real> drucker_prager_coefficients_memo(const SoftenedStrength<Real> &t,
+                                                                          const Real tensile_strength)
+  {
+    struct Memo
+    {
+      bool                            valid;
+      Real                            cohesion, phi, psi, tensile_strength;
+      DruckerPragerCoefficients<Real> k;
+    };
+    static thread_local Memo memo{}; // zero-initialised: not valid
+    if (!(memo.valid && memo.cohesion == t.cohesion && memo.phi == t.phi && memo.psi == t.psi &&
+          memo.tensile_strength == tensile_strength))
+      {
+        memo.k                = drucker_prager_coefficients(current_strength(t), tensile_strength);
+        memo.cohesion         = t.cohesion;
+        memo.phi              = t.phi;
+        memo.psi              = t.psi;
+        memo.tensile_strength = tensile_strength;
+        memo.valid            = true;
+      }
+    return memo.k;
+  }
+
+  // The coefficients at plastic strain eps_p.
+  template <typename Real>
+  MPM_HOST_DEVICE inline DruckerPragerCoefficients<Real>
+  drucker_prager_coefficients_at(const DruckerPragerParameters<Real> &dp, const Real eps_p)
+  {
+#if defined(__CUDA_ARCH__)
+    return drucker_prager_coefficients(current_strength(dp.strength, eps_p), dp.tensile_strength);
+#else
+    return drucker_prager_coefficients_memo(softened_strength(dp.strength, eps_p), dp.tensile_strength);
+#endif
+  }
+
   // Return mapping of a trial stress (in: trial, out: admissible stress).
   // multiplier[0]: shear multiplier (of g_s), multiplier[1]: tension multiplier (of g_t).
   template <typename Real>
@@ -139,11 +179,8 @@ namespace mpm
   {
     return elastoplastic_update(elastic, plasticity_enabled, d_eps, d_spin, stress, plastic_strain,
                                 [&](SymTensor<Real> &trial, const Real eps_p) {
-                                  return drucker_prager_return(
-                                    elastic,
-                                    drucker_prager_coefficients(current_strength(dp.strength, eps_p),
-                                                                dp.tensile_strength),
-                                    trial);
+                                  return drucker_prager_return(elastic, drucker_prager_coefficients_at(dp, eps_p),
+                                                               trial);
                                 });
   }
 } // namespace mpm

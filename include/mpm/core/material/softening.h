@@ -55,17 +55,38 @@ namespace mpm
     return s.friction_angle + (s.residual_friction_angle - s.friction_angle) * xi;
   }
 
+  // Cohesion and angles at one plastic strain (psi capped at phi).
+  template <typename Real>
+  struct SoftenedStrength
+  {
+    Real cohesion, phi, psi;
+  };
+
+  template <typename Real>
+  MPM_HOST_DEVICE inline SoftenedStrength<Real> softened_strength(const SofteningStrength<Real> &s, const Real eps_p)
+  {
+    SoftenedStrength<Real> r;
+    r.phi      = softened_friction_angle(s, eps_p);
+    r.psi      = s.dilatancy_angle < r.phi ? s.dilatancy_angle : r.phi;
+    r.cohesion = softened_cohesion(s, eps_p);
+    return r;
+  }
+
+  template <typename Real>
+  MPM_HOST_DEVICE inline CurrentStrength<Real> current_strength(const SoftenedStrength<Real> &t)
+  {
+    CurrentStrength<Real> r;
+    r.cohesion = t.cohesion;
+    r.sin_phi  = std::sin(t.phi);
+    r.cos_phi  = std::cos(t.phi);
+    r.sin_psi  = std::sin(t.psi);
+    return r;
+  }
+
   template <typename Real>
   MPM_HOST_DEVICE inline CurrentStrength<Real> current_strength(const SofteningStrength<Real> &s, const Real eps_p)
   {
-    CurrentStrength<Real> r;
-    const Real phi = softened_friction_angle(s, eps_p);
-    const Real psi = s.dilatancy_angle < phi ? s.dilatancy_angle : phi;
-    r.cohesion     = softened_cohesion(s, eps_p);
-    r.sin_phi      = std::sin(phi);
-    r.cos_phi      = std::cos(phi);
-    r.sin_psi      = std::sin(psi);
-    return r;
+    return current_strength(softened_strength(s, eps_p));
   }
 
   // What a return mapping did; the tests read it, the step ignores it.
