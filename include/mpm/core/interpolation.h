@@ -27,6 +27,27 @@
 
 namespace mpm
 {
+  // N_i(x_p) and grad N_i(x_p) of stencil position k from the 1D weights and their
+  // derivatives (in cell units; the gradient scaled by inv_h), the products in one fixed
+  // order, shared by every form of the loop below.
+  template <int dim, int n, typename Real>
+  MPM_HOST_DEVICE inline Real stencil_weight(const Real (&w)[dim][n], const Real (&dw)[dim][n], const Real inv_h,
+                                             const int k[3], Real grad[dim])
+  {
+    Real N = Real(1);
+    for (int d = 0; d < dim; ++d)
+      N *= w[d][k[d]];
+    for (int d = 0; d < dim; ++d)
+      {
+        Real g = dw[d][k[d]] * inv_h;
+        for (int e = 0; e < dim; ++e)
+          if (e != d)
+            g *= w[e][k[e]];
+        grad[d] = g;
+      }
+    return N;
+  }
+
 #if !defined(__CUDA_ARCH__)
   // Host: one point's stencil, its 1D weights evaluated once (bit for bit as
   // for_each_stencil_node's), visited as often as a stage needs (G2P velocity and the
@@ -64,19 +85,9 @@ namespace mpm
           inside = inside && first[d] >= 0 && first[d] + n - 1 <= grid.n_cells[d];
         }
       auto visit_position = [&](const int s, const int node) {
-        const int k[3] = {s % n, (s / n) % n, s / (n * n)};
-        Real      N    = Real(1);
-        for (int d = 0; d < dim; ++d)
-          N *= w[d][k[d]];
-        Real grad[dim];
-        for (int d = 0; d < dim; ++d)
-          {
-            Real g = dw[d][k[d]] * inv_h;
-            for (int e = 0; e < dim; ++e)
-              if (e != d)
-                g *= w[e][k[e]];
-            grad[d] = g;
-          }
+        const int  k[3] = {s % n, (s / n) % n, s / (n * n)};
+        Real       grad[dim];
+        const Real N = stencil_weight<dim, n>(w, dw, inv_h, k, grad);
         visit(node, N, grad);
       };
       if (inside)
@@ -135,18 +146,8 @@ namespace mpm
         const int node = grid.node(idx);
         if (node < 0)
           continue; // outside the lattice: the weight is zero for points inside the grid
-        Real N = Real(1);
-        for (int d = 0; d < dim; ++d)
-          N *= w[d][k[d]];
-        Real grad[dim];
-        for (int d = 0; d < dim; ++d)
-          {
-            Real g = dw[d][k[d]] * inv_h;
-            for (int e = 0; e < dim; ++e)
-              if (e != d)
-                g *= w[e][k[e]];
-            grad[d] = g;
-          }
+        Real       grad[dim];
+        const Real N = stencil_weight<dim, n>(w, dw, inv_h, k, grad);
         visit(node, N, grad);
       }
 #  else
