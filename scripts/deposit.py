@@ -201,11 +201,6 @@ def draw(result, png, title, reference):
     plt.close(fig)
 
 
-def bounds(text):
-    lo, hi = (float(v) for v in text.split(","))
-    return lo, hi
-
-
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("output_dir")
@@ -221,9 +216,9 @@ def main():
     parser.add_argument("--title", default="")
     parser.add_argument("--reference", action="store_true", help="draw the V3 experiment (Bui et al. 2008)")
     parser.add_argument("--json", help="write the numbers here")
-    parser.add_argument("--toe", type=bounds)
-    parser.add_argument("--top-left", type=bounds)
-    parser.add_argument("--slope", type=bounds)
+    parser.add_argument("--toe", type=mpm_results.bounds)
+    parser.add_argument("--top-left", type=mpm_results.bounds)
+    parser.add_argument("--slope", type=mpm_results.bounds)
     args = parser.parse_args()
 
     data = mpm_results.particles_at(args.output_dir, args.index)

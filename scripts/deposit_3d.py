@@ -81,9 +81,9 @@ def main():
     parser.add_argument("--png", help="picture of the mid-plane deposit")
     parser.add_argument("--reference", action="store_true", help="draw the V3 experiment (Bui et al. 2008)")
     parser.add_argument("--json")
-    parser.add_argument("--toe", type=deposit.bounds)
-    parser.add_argument("--top-left", type=deposit.bounds)
-    parser.add_argument("--slope", type=deposit.bounds)
+    parser.add_argument("--toe", type=mpm_results.bounds)
+    parser.add_argument("--top-left", type=mpm_results.bounds)
+    parser.add_argument("--slope", type=mpm_results.bounds)
     args = parser.parse_args()
 
     data = mpm_results.particles_at(args.output_dir, args.index)

@@ -56,3 +56,9 @@ def check_limits(checks, digits=4):
         print(f"  check {name}: {value:.{digits}g} in [{lim[0]:g}, {lim[1]:g}]: {'ok' if ok else 'FAILED'}")
         failed |= not ok
     return failed
+
+
+def bounds(text):
+    """argparse type of the scripts' --option LO,HI checks."""
+    lo, hi = (float(v) for v in text.split(","))
+    return lo, hi

@@ -105,11 +105,6 @@ def measure(start, end, threshold, bin_width, base_top, back):
     return r
 
 
-def bounds(text):
-    lo, hi = (float(v) for v in text.split(","))
-    return lo, hi
-
-
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("output_dir")
@@ -120,12 +115,12 @@ def main():
     parser.add_argument("--base-top", type=float, default=1.92, help="top of the base layer (m)")
     parser.add_argument("--back", type=float, default=5.0, help="x below which the ground must stay (m)")
     parser.add_argument("--json")
-    parser.add_argument("--fraction", type=bounds)
-    parser.add_argument("--crown", type=bounds)
-    parser.add_argument("--depth", type=bounds)
+    parser.add_argument("--fraction", type=mpm_results.bounds)
+    parser.add_argument("--crown", type=mpm_results.bounds)
+    parser.add_argument("--depth", type=mpm_results.bounds)
     parser.add_argument("--back-max", type=float)
-    parser.add_argument("--run-out", type=bounds)
-    parser.add_argument("--crest-drop", type=bounds)
+    parser.add_argument("--run-out", type=mpm_results.bounds)
+    parser.add_argument("--crest-drop", type=mpm_results.bounds)
     args = parser.parse_args()
 
     start = mpm_results.particles_at(args.output_dir, output_index(args.output_dir, args.start))

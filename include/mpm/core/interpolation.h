@@ -48,6 +48,24 @@ namespace mpm
     return N;
   }
 
+  // Lattice strides (x fastest, as GridView::node) and the lattice index of the stencil's
+  // first node; returns whether the whole stencil of n nodes per direction lies inside the
+  // lattice (then node indices are base + offsets, with no bounds check per node).
+  template <int dim, int n, typename Real>
+  MPM_HOST_DEVICE inline bool stencil_base(const GridView<dim, Real> &grid, const int first[dim], long stride[dim],
+                                           long &base)
+  {
+    bool inside = true;
+    base        = 0;
+    for (int d = 0; d < dim; ++d)
+      {
+        stride[d] = d == 0 ? 1 : stride[d - 1] * (grid.n_cells[d - 1] + 1);
+        base += first[d] * stride[d];
+        inside = inside && first[d] >= 0 && first[d] + n - 1 <= grid.n_cells[d];
+      }
+    return inside;
+  }
+
 #if !defined(__CUDA_ARCH__)
   // Host: one point's stencil, its 1D weights evaluated once (bit for bit as
   // for_each_stencil_node's), visited as often as a stage needs (G2P velocity and the
@@ -76,14 +94,8 @@ namespace mpm
     void for_each(const GridView<dim, Real> &grid, Visitor &&visit) const
     {
       constexpr int n_stencil = dim == 2 ? n * n : n * n * n;
-      long          stride[dim], base = 0;
-      bool          inside = true;
-      for (int d = 0; d < dim; ++d)
-        {
-          stride[d] = d == 0 ? 1 : stride[d - 1] * (grid.n_cells[d - 1] + 1);
-          base += first[d] * stride[d];
-          inside = inside && first[d] >= 0 && first[d] + n - 1 <= grid.n_cells[d];
-        }
+      long          stride[dim], base;
+      const bool    inside = stencil_base<dim, n>(grid, first, stride, base);
       auto visit_position = [&](const int s, const int node) {
         const int  k[3] = {s % n, (s / n) % n, s / (n * n)};
         Real       grad[dim];
@@ -151,15 +163,8 @@ namespace mpm
         visit(node, N, grad);
       }
 #  else
-    // Lattice strides (x fastest, as GridView::node) and the point's base index.
-    long stride[dim], base = 0;
-    bool inside = true;
-    for (int d = 0; d < dim; ++d)
-      {
-        stride[d] = d == 0 ? 1 : stride[d - 1] * (grid.n_cells[d - 1] + 1);
-        base += first[d] * stride[d];
-        inside = inside && first[d] >= 0 && first[d] + n - 1 <= grid.n_cells[d];
-      }
+    long       stride[dim], base;
+    const bool inside = stencil_base<dim, n>(grid, first, stride, base);
     // Node of stencil position k: by offset inside the lattice, else checked per node
     // (-1 outside the lattice, where the weight is zero for points inside the grid).
     auto node_at = [&](const int k[dim]) {

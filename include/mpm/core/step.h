@@ -483,6 +483,19 @@ namespace mpm
     void sum_cells(const Exchange &, Real *const *, const int, long)
     {}
 
+    // Lattice cell of point i and its mean stress tr(sigma)/3 (plane strain: sigma_zz
+    // included), for both passes of the pressure averaging.
+    template <int dim, typename Real>
+    MPM_HOST_DEVICE inline int cell_and_mean_stress(const GridView<dim, Real> &g, const PointsView<dim, Real> &p,
+                                                    const int i, Real &mean)
+    {
+      Real x[dim];
+      for (int d = 0; d < dim; ++d)
+        x[d] = p.position[d][i];
+      mean = (p.stress[0][i] + p.stress[1][i] + p.stress[2][i]) / Real(3);
+      return g.lattice_cell(x);
+    }
+
     // Cell pressure averaging (against volumetric locking, as in ep2-3De): every point
     // of a lattice cell gets the volume-weighted mean pressure of the cell,
     //   p_c = sum_p V_p p_p / sum_p V_p,   sigma_p <- s_p - p_c I   (s_p deviatoric part kept),
@@ -503,12 +516,9 @@ namespace mpm
       backend.scatter_points(p.n_points, [=] MPM_HOST_DEVICE(const int i) {
         if (p.material[i] < 0)
           return;
-        Real x[dim];
-        for (int d = 0; d < dim; ++d)
-          x[d] = p.position[d][i];
-        const int  c    = g.lattice_cell(x);
-        const Real V    = p.volume[i];
-        const Real mean = (p.stress[0][i] + p.stress[1][i] + p.stress[2][i]) / Real(3);
+        Real       mean;
+        const int  c = cell_and_mean_stress(g, p, i, mean);
+        const Real V = p.volume[i];
         Real *const targets[2] = {g.cell_volume, g.cell_pressure_volume};
         const Real  values[2]  = {V, V * mean};
         Backend::template add_to_node<2>(targets, c, values);
@@ -520,12 +530,9 @@ namespace mpm
       backend.gather_points(p.n_points, [=] MPM_HOST_DEVICE(const int i) {
         if (p.material[i] < 0)
           return;
-        Real x[dim];
-        for (int d = 0; d < dim; ++d)
-          x[d] = p.position[d][i];
-        const int  c      = g.lattice_cell(x);
-        const Real mean   = (p.stress[0][i] + p.stress[1][i] + p.stress[2][i]) / Real(3);
-        const Real shift  = g.cell_pressure_volume[c] / g.cell_volume[c] - mean;
+        Real       mean;
+        const int  c     = cell_and_mean_stress(g, p, i, mean);
+        const Real shift = g.cell_pressure_volume[c] / g.cell_volume[c] - mean;
         for (int k = 0; k < 3; ++k)
           p.stress[k][i] += shift;
       });
