@@ -27,25 +27,40 @@
 
 namespace mpm
 {
-  // N_i(x_p) and grad N_i(x_p) of stencil position k from the 1D weights and their
-  // derivatives (in cell units; the gradient scaled by inv_h), the products in one fixed
-  // order, shared by every form of the loop below.
+  // N_i(x_p) and grad N_i(x_p) from the 1D weights wk[d] and derivatives dwk[d] (in cell
+  // units; the gradient scaled by inv_h) at the node's stencil position, the products in
+  // one fixed order, shared by every form of the loop below and by the CUDA backend's
+  // stencil scatter (CudaBackend::scatter_stencil).
+  template <int dim, typename Real>
+  MPM_HOST_DEVICE inline Real stencil_weight_at(const Real wk[dim], const Real dwk[dim], const Real inv_h,
+                                                Real grad[dim])
+  {
+    Real N = Real(1);
+    for (int d = 0; d < dim; ++d)
+      N *= wk[d];
+    for (int d = 0; d < dim; ++d)
+      {
+        Real g = dwk[d] * inv_h;
+        for (int e = 0; e < dim; ++e)
+          if (e != d)
+            g *= wk[e];
+        grad[d] = g;
+      }
+    return N;
+  }
+
+  // The same for stencil position k of a point's 1D weight tables.
   template <int dim, int n, typename Real>
   MPM_HOST_DEVICE inline Real stencil_weight(const Real (&w)[dim][n], const Real (&dw)[dim][n], const Real inv_h,
                                              const int k[3], Real grad[dim])
   {
-    Real N = Real(1);
-    for (int d = 0; d < dim; ++d)
-      N *= w[d][k[d]];
+    Real wk[dim], dwk[dim];
     for (int d = 0; d < dim; ++d)
       {
-        Real g = dw[d][k[d]] * inv_h;
-        for (int e = 0; e < dim; ++e)
-          if (e != d)
-            g *= w[e][k[e]];
-        grad[d] = g;
+        wk[d]  = w[d][k[d]];
+        dwk[d] = dw[d][k[d]];
       }
-    return N;
+    return stencil_weight_at<dim>(wk, dwk, inv_h, grad);
   }
 
   // Lattice strides (x fastest, as GridView::node) and the lattice index of the stencil's

@@ -2,12 +2,14 @@
 //
 // A Backend says how loops run (see backend/cpu_backend.h): for_each_node,
 // gather_points (a point writes only its own data), scatter_points (points add into
-// nodes through Backend::add_to_node, once per node or cell), reduce_points. The
+// the nodes of their stencil through Backend::scatter_stencil, or into a cell through
+// Backend::add_to_node), reduce_points. The
 // stages below are what MUSL, USL and USF are made of; explicit_step() reads as the
 // algorithm (doc/theory.md).
 #pragma once
 
 #include <mpm/core/interpolation.h>
+#include <mpm/core/stencil_contribution.h>
 #include <mpm/core/material/material.h>
 #include <mpm/core/shape_functions.h>
 #include <mpm/core/small_tensor.h>
@@ -174,7 +176,9 @@ namespace mpm
         for (int c = 0; c < n_voigt; ++c)
           sigma[c] = p.stress[c][i];
 
-        // Nodal arrays in the order of the values below: mass, momentum, force.
+        // Nodal arrays in the order of the values: mass, momentum, force. Each value is
+        // linear in N and grad N (stencil_contribution.h): mass m N, momentum m v N, force
+        // m g N - V sigma . grad N.
         constexpr int K = 2 * dim + 1;
         Real         *targets[K];
         targets[0] = g.mass;
@@ -183,34 +187,49 @@ namespace mpm
             targets[1 + d]       = g.momentum[d];
             targets[1 + dim + d] = g.force[d];
           }
-        auto visit = [&](const int n, const Real N, const Real *grad) {
-          Real values[K];
-          values[0] = N * m;
-          for (int d = 0; d < dim; ++d)
-            {
-              values[1 + d] = N * m * v[d];
-              Real f_int    = Real(0);
-              for (int e = 0; e < dim; ++e)
-                f_int -= sigma(d, e) * grad[e];
-              values[1 + dim + d] = V * f_int + N * m * s.gravity[d];
-            }
-          if (mass_and_momentum && forces)
-            Backend::template add_to_node<K>(targets, n, values);
-          else if (mass_and_momentum)
-            Backend::template add_to_node<dim + 1>(targets, n, values);
-          else if (forces)
-            Backend::template add_to_node<dim>(targets + dim + 1, n, values + dim + 1);
-        };
+        StencilContribution<dim, K, dim, Real> all;
+        all.c_N[0] = m;
+        for (int d = 0; d < dim; ++d)
+          {
+            all.c_N[1 + d]       = m * v[d];
+            all.c_N[1 + dim + d] = m * s.gravity[d];
+            for (int e = 0; e < dim; ++e)
+              all.c_grad[d][e] = -V * sigma(d, e);
+          }
         (void)stencils; // captured in both compilation passes (nvcc's extended lambdas need the same captures)
 #if defined(__CUDA_ARCH__) || defined(MPM_UNROLL_STENCIL)
-        for_each_stencil_node<dim, Shape>(g, x, lp, visit);
+        auto scatter = [&](const auto &contribution, Real *const *into) {
+          Backend::template scatter_stencil<dim, Shape>(g, x, lp, into, contribution);
+        };
 #else
         // Host: the stencil, kept for the later stages of the step where they asked for it.
         const HostStencil<dim, Shape, Real> stencil(g, x, lp);
         if (stencils != nullptr)
           static_cast<HostStencil<dim, Shape, Real> *>(stencils)[i] = stencil;
-        stencil.for_each(g, visit);
+        auto scatter = [&](const auto &contribution, Real *const *into) {
+          add_contribution<Backend>([&](auto &&visit) { stencil.for_each(g, visit); }, into, contribution);
+        };
 #endif
+        if (mass_and_momentum && forces)
+          scatter(all, targets);
+        else if (mass_and_momentum)
+          {
+            StencilContribution<dim, dim + 1, 0, Real> mass_momentum;
+            for (int k = 0; k <= dim; ++k)
+              mass_momentum.c_N[k] = all.c_N[k];
+            scatter(mass_momentum, targets);
+          }
+        else if (forces)
+          {
+            StencilContribution<dim, dim, dim, Real> force;
+            for (int d = 0; d < dim; ++d)
+              {
+                force.c_N[d] = all.c_N[1 + dim + d];
+                for (int e = 0; e < dim; ++e)
+                  force.c_grad[d][e] = all.c_grad[d][e];
+              }
+            scatter(force, targets + dim + 1);
+          }
       });
     }
 
@@ -342,15 +361,18 @@ namespace mpm
             p.velocity[d][i] = v_new[d];
             mv[d]            = m * v_new[d];
           }
-        Real *targets[dim];
+        Real                                 *targets[dim];
+        StencilContribution<dim, dim, 0, Real> momentum;
         for (int d = 0; d < dim; ++d)
-          targets[d] = g.momentum[d];
-        stencil([&](const int n, const Real N, const Real *) {
-          Real values[dim];
-          for (int d = 0; d < dim; ++d)
-            values[d] = N * mv[d];
-          Backend::template add_to_node<dim>(targets, n, values);
-        });
+          {
+            targets[d]        = g.momentum[d];
+            momentum.c_N[d] = mv[d];
+          }
+#if defined(__CUDA_ARCH__) || defined(MPM_UNROLL_STENCIL)
+        Backend::template scatter_stencil<dim, Shape>(g, x, lp, targets, momentum);
+#else
+        add_contribution<Backend>(stencil, targets, momentum);
+#endif
       });
     }
 

@@ -38,6 +38,8 @@
 #pragma once
 
 #include <mpm/core/config.h>
+#include <mpm/core/interpolation.h>
+#include <mpm/core/stencil_contribution.h>
 
 #include <cstddef>
 #include <vector>
@@ -66,6 +68,16 @@ namespace mpm
     {
       for (int k = 0; k < K; ++k)
         targets[k][entry] += values[k];
+    }
+
+    // A point's contribution into each node of its stencil (step.h, device code only; the
+    // host stages use the point's HostStencil with add_contribution directly).
+    template <int dim, typename Shape, int K, int Kg, typename Real>
+    MPM_HOST_DEVICE static void scatter_stencil(const GridView<dim, Real> &g, const Real x[dim], const Real lp[dim],
+                                                Real *const *targets, const StencilContribution<dim, K, Kg, Real> &c)
+    {
+      add_contribution<CpuBackend>([&](auto &&visit) { for_each_stencil_node<dim, Shape>(g, x, lp, visit); }, targets,
+                                   c);
     }
 
     template <typename F>

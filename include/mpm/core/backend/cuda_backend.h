@@ -19,6 +19,8 @@
 
 #include <mpm/core/backend/cuda_check.h>
 #include <mpm/core/config.h>
+#include <mpm/core/interpolation.h>
+#include <mpm/core/stencil_contribution.h>
 
 #include <cuda_runtime.h>
 
@@ -114,6 +116,18 @@ namespace mpm
       __shared__ alignas(16) unsigned char bytes[max_staging_threads * max_staged_bytes_per_lane];
       return bytes;
     }
+
+    // Shared memory where the lanes of a block stage their stencil records for
+    // CudaBackend::scatter_stencil: up to max_record_values per lane (3D GIMP P2G: 35),
+    // max_stencil_threads lanes. One array per kernel, whichever scatters it instantiates.
+    constexpr int max_stencil_threads = 128;
+    constexpr int max_record_values   = 35;
+    template <typename Real>
+    __device__ inline Real *stencil_records()
+    {
+      __shared__ Real records[max_stencil_threads * max_record_values];
+      return records;
+    }
   } // namespace cuda_detail
 
   class CudaBackend
@@ -204,6 +218,130 @@ namespace mpm
 #else
       for (int k = 0; k < K; ++k)
         targets[k][entry] += values[k];
+#endif
+    }
+
+    // A point's contribution into each node of its stencil (stencil_contribution.h),
+    // called by every thread of a scatter_points loop for its point. On the device the
+    // lanes of a warp whose stencils start at the same node (a run: points sorted by
+    // stencil, backend/cuda_point_order.h, come in runs of 4 in 2D and 8 in 3D) share the
+    // work by nodes instead of by points: each lane stages its 1D weights and
+    // coefficients in shared memory, then lane j of a run of length R sums stencil nodes
+    // j, j + R, ... over the run's points and issues one atomicAdd per value and node.
+    // A point then costs about one node's worth of weight products per node, with no
+    // per-node reduction, and the L2 sees one atomic per run, node and value. N and grad N
+    // come from stencil_weight_at and the values from StencilContribution::values: the
+    // same arithmetic as the CPU. Points whose stencil is not wholly inside the lattice
+    // are runs of one. A warp that is not fully converged (a removed point, the last
+    // partial warp) or a block larger than the staging area adds point by point.
+    template <int dim, typename Shape, int K, int Kg, typename Real>
+    MPM_HOST_DEVICE static void scatter_stencil(const GridView<dim, Real> &g, const Real x[dim], const Real lp[dim],
+                                                Real *const *targets, const StencilContribution<dim, K, Kg, Real> &c)
+    {
+#if defined(__CUDA_ARCH__)
+      constexpr int      n         = Shape::n_per_direction;
+      constexpr int      n_stencil = dim == 2 ? n * n : n * n * n;
+      constexpr int      n_w       = dim * n;                  // 1D weights, then derivatives if Kg > 0
+      constexpr int      at_c_N    = (Kg > 0 ? 2 : 1) * n_w;   // then c_N[K], then c_grad[Kg][dim]
+      constexpr int      at_c_grad = at_c_N + K;
+      constexpr int      stride    = (at_c_grad + Kg * dim) | 1;
+      constexpr unsigned all       = 0xffffffffu;
+      // Odd: the 16 lanes of a half-warp's 8-byte accesses fall in different banks.
+      static_assert(stride % 2 == 1 && stride <= cuda_detail::max_record_values, "record too long");
+      if (__activemask() != all || blockDim.x > cuda_detail::max_stencil_threads)
+        {
+          for_each_stencil_node<dim, Shape>(g, x, lp, [&](const int node, const Real N, const Real *grad) {
+            Real values[K];
+            c.values(N, grad, values);
+            for (int v = 0; v < K; ++v)
+              atomicAdd(&targets[v][node], values[v]);
+          });
+          return;
+        }
+      const int  lane  = static_cast<int>(threadIdx.x) & 31;
+      const Real inv_h = Real(1) / g.h;
+      int        first[dim];
+      Real       w[dim][n], dw[dim][n];
+      for (int d = 0; d < dim; ++d)
+        Shape::weights_1d((x[d] - g.origin[d]) * inv_h, lp[d] * inv_h, first[d], w[d], dw[d]);
+      long       lattice_stride[dim], base;
+      const bool inside = stencil_base<dim, n>(g, first, lattice_stride, base);
+
+      // Runs of neighbouring lanes with the same first stencil node.
+      const long     key   = inside ? base : -1 - lane;
+      const long     prev  = __shfl_up_sync(all, key, 1);
+      const unsigned heads = __ballot_sync(all, lane == 0 || prev != key);
+      const int      head  = 31 - __clz(static_cast<int>(heads & (all >> (31 - lane))));
+      const unsigned later = lane == 31 ? 0u : heads & (all << (lane + 1));
+      const int      last  = later != 0u ? __ffs(static_cast<int>(later)) - 2 : 31;
+      const int      length = last - head + 1;
+
+      Real *records = cuda_detail::stencil_records<Real>() + (threadIdx.x & ~31u) * stride;
+      Real *mine    = records + lane * stride;
+      for (int d = 0; d < dim; ++d)
+        for (int j = 0; j < n; ++j)
+          {
+            mine[d * n + j] = w[d][j];
+            if (Kg > 0)
+              mine[n_w + d * n + j] = dw[d][j];
+          }
+      for (int k = 0; k < K; ++k)
+        mine[at_c_N + k] = c.c_N[k];
+      for (int k = 0; k < Kg; ++k)
+        for (int e = 0; e < dim; ++e)
+          mine[at_c_grad + k * dim + e] = c.c_grad[k][e];
+      __syncwarp();
+
+      for (int s = lane - head; s < n_stencil; s += length)
+        {
+          const int k[3] = {s % n, (s / n) % n, s / (n * n)};
+          Real      sum[K];
+          for (int v = 0; v < K; ++v)
+            sum[v] = Real(0);
+          for (int l = head; l <= last; ++l)
+            {
+              const Real *record = records + l * stride;
+              Real        wk[dim], dwk[dim], grad[dim];
+              for (int d = 0; d < dim; ++d)
+                {
+                  wk[d]  = record[d * n + k[d]];
+                  dwk[d] = Kg > 0 ? record[n_w + d * n + k[d]] : Real(0);
+                }
+              const Real N = stencil_weight_at<dim>(wk, dwk, inv_h, grad);
+              StencilContribution<dim, K, Kg, Real> point;
+              for (int v = 0; v < K; ++v)
+                point.c_N[v] = record[at_c_N + v];
+              for (int v = 0; v < Kg; ++v)
+                for (int e = 0; e < dim; ++e)
+                  point.c_grad[v][e] = record[at_c_grad + v * dim + e];
+              Real values[K];
+              point.values(N, grad, values);
+              for (int v = 0; v < K; ++v)
+                sum[v] += values[v];
+            }
+          int node;
+          if (inside)
+            {
+              long offset = 0;
+              for (int d = 0; d < dim; ++d)
+                offset += k[d] * lattice_stride[d];
+              node = g.lattice_to_node[base + offset];
+            }
+          else
+            {
+              int idx[dim];
+              for (int d = 0; d < dim; ++d)
+                idx[d] = first[d] + k[d];
+              node = g.node(idx);
+            }
+          if (node >= 0) // else absent, or outside the lattice where the weight is zero
+            for (int v = 0; v < K; ++v)
+              atomicAdd(&targets[v][node], sum[v]);
+        }
+      __syncwarp(); // the records are reused by the next call
+#else
+      add_contribution<CudaBackend>([&](auto &&visit) { for_each_stencil_node<dim, Shape>(g, x, lp, visit); }, targets,
+                                    c);
 #endif
     }
 
