@@ -118,16 +118,37 @@ namespace mpm
     }
 
     // Shared memory where the lanes of a block stage their stencil records for
-    // CudaBackend::scatter_stencil: up to max_record_values per lane (3D GIMP P2G: 35),
-    // max_stencil_threads lanes. One array per kernel, whichever scatters it instantiates.
+    // CudaBackend::scatter_stencil: up to max_record_values per lane (3D GIMP P2G: 34),
+    // max_stencil_threads lanes, 16-byte aligned for paired loads; and per warp a table
+    // of its runs (head lane, length, first stencil node). One of each per kernel,
+    // whichever scatters it instantiates.
     constexpr int max_stencil_threads = 128;
-    constexpr int max_record_values   = 35;
+    constexpr int max_record_values   = 34;
+    constexpr int run_entry_ints      = 5; // head, length, first[3]
     template <typename Real>
     __device__ inline Real *stencil_records()
     {
-      __shared__ Real records[max_stencil_threads * max_record_values];
+      __shared__ alignas(16) Real records[max_stencil_threads * max_record_values];
       return records;
     }
+    __device__ inline int *stencil_runs()
+    {
+      __shared__ int runs[max_stencil_threads * run_entry_ints];
+      return runs;
+    }
+    // Two values in one 8- or 16-byte shared-memory load.
+    template <typename Real>
+    struct Pair;
+    template <>
+    struct Pair<double>
+    {
+      using type = double2;
+    };
+    template <>
+    struct Pair<float>
+    {
+      using type = float2;
+    };
   } // namespace cuda_detail
 
   class CudaBackend
@@ -223,31 +244,38 @@ namespace mpm
 
     // A point's contribution into each node of its stencil (stencil_contribution.h),
     // called by every thread of a scatter_points loop for its point. On the device the
-    // lanes of a warp whose stencils start at the same node (a run: points sorted by
-    // stencil, backend/cuda_point_order.h, come in runs of 4 in 2D and 8 in 3D) share the
-    // work by nodes instead of by points: each lane stages its 1D weights and
-    // coefficients in shared memory, then lane j of a run of length R sums stencil nodes
-    // j, j + R, ... over the run's points and issues one atomicAdd per value and node.
-    // A point then costs about one node's worth of weight products per node, with no
-    // per-node reduction, and the L2 sees one atomic per run, node and value. N and grad N
-    // come from stencil_weight_at and the values from StencilContribution::values: the
-    // same arithmetic as the CPU. Points whose stencil is not wholly inside the lattice
-    // are runs of one. A warp that is not fully converged (a removed point, the last
-    // partial warp) or a block larger than the staging area adds point by point.
+    // lanes of a warp share the work by (run, node) instead of by point. A run is a
+    // stretch of neighbouring lanes whose stencils start at the same node (points sorted
+    // by stencil, backend/cuda_point_order.h, come in runs of 4 in 2D and 8 in 3D): its
+    // points add into the same nodes. Each lane stages its 1D weights and coefficients in
+    // shared memory; then the warp's tasks (every run x every stencil node) are dealt
+    // round robin to the 32 lanes, and a task sums its node's values over the run's points
+    // and issues one atomicAdd per value. So a point costs one node's weight products per
+    // node, there is no per-node reduction, the L2 sees one atomic per run, node and
+    // value, and runs cut by warp boundaries or of uneven length keep the lanes evenly
+    // busy. N and grad N come from stencil_weight_at and the values from
+    // StencilContribution::values: the same arithmetic as the CPU. Points whose stencil
+    // is not wholly inside the lattice are runs of one. A warp that is not fully
+    // converged (a removed point, the last partial warp) or a block larger than the
+    // staging area adds point by point.
     template <int dim, typename Shape, int K, int Kg, typename Real>
     MPM_HOST_DEVICE static void scatter_stencil(const GridView<dim, Real> &g, const Real x[dim], const Real lp[dim],
                                                 Real *const *targets, const StencilContribution<dim, K, Kg, Real> &c)
     {
 #if defined(__CUDA_ARCH__)
-      constexpr int      n         = Shape::n_per_direction;
-      constexpr int      n_stencil = dim == 2 ? n * n : n * n * n;
-      constexpr int      n_w       = dim * n;                  // 1D weights, then derivatives if Kg > 0
-      constexpr int      at_c_N    = (Kg > 0 ? 2 : 1) * n_w;   // then c_N[K], then c_grad[Kg][dim]
-      constexpr int      at_c_grad = at_c_N + K;
-      constexpr int      stride    = (at_c_grad + Kg * dim) | 1;
-      constexpr unsigned all       = 0xffffffffu;
-      // Odd: the 16 lanes of a half-warp's 8-byte accesses fall in different banks.
-      static_assert(stride % 2 == 1 && stride <= cuda_detail::max_record_values, "record too long");
+      using Pair                     = typename cuda_detail::Pair<Real>::type;
+      constexpr int      n           = Shape::n_per_direction;
+      constexpr int      n_stencil   = dim == 2 ? n * n : n * n * n;
+      constexpr int      n_w         = dim * n;
+      constexpr bool     with_grad   = Kg > 0;
+      // Record: the 1D weights (w, dw) in pairs (or w alone), then the coefficients
+      // c_N[K], c_grad[Kg][dim], read in pairs: every offset even.
+      constexpr int      at_c        = with_grad ? 2 * n_w : n_w + n_w % 2;
+      constexpr int      n_c         = K + Kg * dim;
+      constexpr int      n_c_even    = n_c + n_c % 2;
+      constexpr int      stride      = at_c + n_c_even;
+      constexpr unsigned all         = 0xffffffffu;
+      static_assert(stride <= cuda_detail::max_record_values, "stencil record too long for the staging area");
       if (__activemask() != all || blockDim.x > cuda_detail::max_stencil_threads)
         {
           for_each_stencil_node<dim, Shape>(g, x, lp, [&](const int node, const Real N, const Real *grad) {
@@ -267,78 +295,102 @@ namespace mpm
       long       lattice_stride[dim], base;
       const bool inside = stencil_base<dim, n>(g, first, lattice_stride, base);
 
-      // Runs of neighbouring lanes with the same first stencil node.
-      const long     key   = inside ? base : -1 - lane;
-      const long     prev  = __shfl_up_sync(all, key, 1);
-      const unsigned heads = __ballot_sync(all, lane == 0 || prev != key);
-      const int      head  = 31 - __clz(static_cast<int>(heads & (all >> (31 - lane))));
-      const unsigned later = lane == 31 ? 0u : heads & (all << (lane + 1));
-      const int      last  = later != 0u ? __ffs(static_cast<int>(later)) - 2 : 31;
-      const int      length = last - head + 1;
+      // Runs of neighbouring lanes with the same first stencil node, and the warp's table
+      // of them (filled by each run's head).
+      const long     key    = inside ? base : -1 - lane;
+      const long     prev   = __shfl_up_sync(all, key, 1);
+      const unsigned heads  = __ballot_sync(all, lane == 0 || prev != key);
+      const unsigned upto   = all >> (31 - lane);
+      const int      head   = 31 - __clz(static_cast<int>(heads & upto));
+      const int      n_runs = __popc(heads);
+      int *runs = cuda_detail::stencil_runs() + (threadIdx.x & ~31u) * cuda_detail::run_entry_ints;
+      if (lane == head)
+        {
+          const unsigned later = lane == 31 ? 0u : heads & (all << (lane + 1));
+          int           *entry = runs + (__popc(heads & upto) - 1) * cuda_detail::run_entry_ints;
+          entry[0]             = lane;
+          entry[1]             = (later != 0u ? __ffs(static_cast<int>(later)) - 1 : 32) - lane;
+          for (int d = 0; d < dim; ++d)
+            entry[2 + d] = first[d];
+        }
 
       Real *records = cuda_detail::stencil_records<Real>() + (threadIdx.x & ~31u) * stride;
       Real *mine    = records + lane * stride;
       for (int d = 0; d < dim; ++d)
         for (int j = 0; j < n; ++j)
-          {
+          if (with_grad)
+            reinterpret_cast<Pair *>(mine)[d * n + j] = Pair{w[d][j], dw[d][j]};
+          else
             mine[d * n + j] = w[d][j];
-            if (Kg > 0)
-              mine[n_w + d * n + j] = dw[d][j];
-          }
-      for (int k = 0; k < K; ++k)
-        mine[at_c_N + k] = c.c_N[k];
-      for (int k = 0; k < Kg; ++k)
-        for (int e = 0; e < dim; ++e)
-          mine[at_c_grad + k * dim + e] = c.c_grad[k][e];
+      {
+        Real coefficients[n_c_even];
+        for (int v = 0; v < K; ++v)
+          coefficients[v] = c.c_N[v];
+        for (int v = 0; v < Kg; ++v)
+          for (int e = 0; e < dim; ++e)
+            coefficients[K + v * dim + e] = c.c_grad[v][e];
+        if (n_c % 2 == 1)
+          coefficients[n_c_even - 1] = Real(0);
+        for (int v = 0; v < n_c_even; v += 2)
+          reinterpret_cast<Pair *>(mine + at_c)[v / 2] = Pair{coefficients[v], coefficients[v + 1]};
+      }
       __syncwarp();
 
-      for (int s = lane - head; s < n_stencil; s += length)
+      for (int task = lane; task < n_runs * n_stencil; task += 32)
         {
-          const int k[3] = {s % n, (s / n) % n, s / (n * n)};
-          Real      sum[K];
+          const int  run    = task / n_stencil;
+          const int  s      = task - run * n_stencil;
+          const int  k[3]   = {s % n, (s / n) % n, s / (n * n)};
+          const int *entry  = runs + run * cuda_detail::run_entry_ints;
+          const int  from   = entry[0];
+          const int  to     = from + entry[1];
+          Real       sum[K];
           for (int v = 0; v < K; ++v)
             sum[v] = Real(0);
-          for (int l = head; l <= last; ++l)
+          for (int l = from; l < to; ++l)
             {
               const Real *record = records + l * stride;
               Real        wk[dim], dwk[dim], grad[dim];
               for (int d = 0; d < dim; ++d)
-                {
-                  wk[d]  = record[d * n + k[d]];
-                  dwk[d] = Kg > 0 ? record[n_w + d * n + k[d]] : Real(0);
-                }
+                if (with_grad)
+                  {
+                    const Pair wp = reinterpret_cast<const Pair *>(record)[d * n + k[d]];
+                    wk[d]         = wp.x;
+                    dwk[d]        = wp.y;
+                  }
+                else
+                  {
+                    wk[d]  = record[d * n + k[d]];
+                    dwk[d] = Real(0);
+                  }
               const Real N = stencil_weight_at<dim>(wk, dwk, inv_h, grad);
+              Real       coefficients[n_c_even];
+              for (int v = 0; v < n_c_even; v += 2)
+                {
+                  const Pair cp       = reinterpret_cast<const Pair *>(record + at_c)[v / 2];
+                  coefficients[v]     = cp.x;
+                  coefficients[v + 1] = cp.y;
+                }
               StencilContribution<dim, K, Kg, Real> point;
               for (int v = 0; v < K; ++v)
-                point.c_N[v] = record[at_c_N + v];
+                point.c_N[v] = coefficients[v];
               for (int v = 0; v < Kg; ++v)
                 for (int e = 0; e < dim; ++e)
-                  point.c_grad[v][e] = record[at_c_grad + v * dim + e];
+                  point.c_grad[v][e] = coefficients[K + v * dim + e];
               Real values[K];
               point.values(N, grad, values);
               for (int v = 0; v < K; ++v)
                 sum[v] += values[v];
             }
-          int node;
-          if (inside)
-            {
-              long offset = 0;
-              for (int d = 0; d < dim; ++d)
-                offset += k[d] * lattice_stride[d];
-              node = g.lattice_to_node[base + offset];
-            }
-          else
-            {
-              int idx[dim];
-              for (int d = 0; d < dim; ++d)
-                idx[d] = first[d] + k[d];
-              node = g.node(idx);
-            }
+          int idx[dim];
+          for (int d = 0; d < dim; ++d)
+            idx[d] = entry[2 + d] + k[d];
+          const int node = g.node(idx);
           if (node >= 0) // else absent, or outside the lattice where the weight is zero
             for (int v = 0; v < K; ++v)
               atomicAdd(&targets[v][node], sum[v]);
         }
-      __syncwarp(); // the records are reused by the next call
+      __syncwarp(); // the records and the run table are reused by the next call
 #else
       add_contribution<CudaBackend>([&](auto &&visit) { for_each_stencil_node<dim, Shape>(g, x, lp, visit); }, targets,
                                     c);
