@@ -152,9 +152,9 @@ namespace
   }
 
   const char *musl_launch_names[] = {"reset grid",     "P2G mass+momentum+forces", "grid update",
-                                     "reset momentum", "G2P velocity + remap P2G", "nodal velocity",
+                                     "G2P velocity + remap P2G", "nodal velocity",
                                      "G2P kinematics+stress", "reduction (dt)"};
-  constexpr int n_musl_launches = 8;
+  constexpr int n_musl_launches = 7;
 
   template <typename Real>
   bool run_size(const int n_cells_y, const Options &opt, const double bandwidth, FILE *table)

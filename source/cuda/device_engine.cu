@@ -145,11 +145,7 @@ namespace mpm
     void DeviceEngine<dim>::download_points(HostPoints<dim, double> &p) const
     {
       impl->backend.synchronize();
-      HostPoints<dim, double> slots;
-      std::vector<int>        original;
-      impl->points.download(slots);
-      impl->order.original_index().download(original);
-      PointOrder<dim, double>::restore_reference_order(original, slots, p);
+      impl->order.download_in_reference_order(impl->backend, impl->points, p);
     }
 
     template <int dim>

@@ -74,17 +74,13 @@ namespace mpm_test
     void finish()
     {
       backend.synchronize();
-      mpm::HostPoints<dim, Real> slots;
-      std::vector<int>           original;
-      device_points.download(slots);
-      order.original_index().download(original);
-      mpm::PointOrder<dim, Real>::restore_reference_order(original, slots, host_points);
+      order.download_in_reference_order(backend, device_points, host_points);
       device_grid.download_nodal(host_grid);
     }
   };
 
-  // The same, with the points sorted by stencil every 7 steps (add_to_node then
-  // reduce runs of shared nodes; results must not change beyond rounding).
+  // The same, with the points sorted by stencil every 7 steps (scatter_stencil then
+  // sums runs of shared nodes; results must not change beyond rounding).
   template <int dim, typename Real>
   struct CudaSortedTarget : CudaTarget<dim, Real>
   {

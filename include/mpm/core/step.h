@@ -234,10 +234,12 @@ namespace mpm
     }
 
     // Grid update: local damping f <- f - D |f| sign(v), boundary masks, explicit
-    // momentum update. Leaves the acceleration in force[] and v^{n+1} in velocity[].
+    // momentum update. Leaves the acceleration in force[] and v^{n+1} in velocity[], and
+    // p^{n+1} in momentum[], or zero where the next stage rebuilds the momentum from the
+    // points (MUSL's remap: one pass over the nodes less).
     template <int dim, typename Real, typename Backend>
     void update_grid(Backend &backend, const GridView<dim, Real> &g, const StepSettings<dim, Real> &s,
-                     const Real dt)
+                     const Real dt, const bool zero_momentum = false)
     {
       backend.for_each_node(g.n_nodes, [=] MPM_HOST_DEVICE(const int n) {
         const Real m = g.mass[n];
@@ -254,7 +256,7 @@ namespace mpm
             if (v != Real(0))
               f -= s.damping * std::fabs(f) * (v > Real(0) ? Real(1) : Real(-1));
             const Real p_new = g.momentum[d][n] + dt * f;
-            g.momentum[d][n] = p_new;
+            g.momentum[d][n] = zero_momentum ? Real(0) : p_new;
             g.velocity[d][n] = p_new / m;
             g.force[d][n]    = f / m;
           }
@@ -321,18 +323,15 @@ namespace mpm
     }
 
     // MUSL: G2P velocity, then the remap of the nodal momentum from the updated point
-    // velocities, sum N m_p v_p, rebuilt from zero. Fused into one pass over the points,
-    // which reads each point once for both (the remap reads only what the gather wrote
-    // and the grid's velocity and acceleration, which it does not write).
+    // velocities, sum N m_p v_p, rebuilt from zero (update_grid left it zero). Fused into
+    // one pass over the points, which reads each point once for both (the remap reads only
+    // what the gather wrote and the grid's velocity and acceleration, which it does not
+    // write).
     template <int dim, typename Shape, typename Real, typename Backend>
     void grid_to_particle_velocity_and_remap(Backend &backend, const GridView<dim, Real> &g,
                                              const PointsView<dim, Real> &p, const StepSettings<dim, Real> &s,
                                              const Real dt, const void *stencils = nullptr)
     {
-      backend.for_each_node(g.n_nodes, [=] MPM_HOST_DEVICE(const int n) {
-        for (int d = 0; d < dim; ++d)
-          g.momentum[d][n] = Real(0);
-      });
       backend.scatter_points(p.n_points, [=] MPM_HOST_DEVICE(const int i) {
         if (p.material[i] < 0)
           return;
@@ -625,7 +624,7 @@ namespace mpm
             particles_to_grid<dim, Shape>(backend, g, p, s, true, true, stencils);
             exchange.sum_nodal(mass_and_momentum, dim + 1);
             exchange.sum_nodal(forces, dim);
-            update_grid(backend, g, s, dt);
+            update_grid(backend, g, s, dt, true);
             grid_to_particle_velocity_and_remap<dim, Shape>(backend, g, p, s, dt, stencils);
             exchange.sum_nodal(momentum, dim);
             velocity_from_momentum(backend, g, s.mass_tolerance);
