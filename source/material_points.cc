@@ -377,7 +377,8 @@ namespace mpm
   double MaterialPoints<dim>::imbalance() const
   {
     // The work model of the partition's cell weights: cells plus weighted points.
-    const double local = grid.triangulation.n_locally_owned_active_cells() +
+    const double local = (grid.distributed ? grid.distributed->n_locally_owned_active_cells() :
+                                             grid.triangulation.n_active_cells()) +
                          point_weight * static_cast<double>(handler.n_locally_owned_particles());
     const double most  = dealii::Utilities::MPI::max(local, grid.communicator);
     const double total = dealii::Utilities::MPI::sum(local, grid.communicator);
@@ -390,7 +391,8 @@ namespace mpm
     // As deal.II's step-68: the handler packs its points with their cells, p4est moves
     // cells by weight, the handler unpacks them on the new owners.
     handler.prepare_for_coarsening_and_refinement();
-    grid.triangulation.repartition();
+    Assert(grid.distributed, dealii::ExcInternalError()); // only called on several ranks
+    grid.distributed->repartition();
     handler.unpack_after_coarsening_and_refinement();
     grid.distribute_nodes();
   }
