@@ -191,6 +191,8 @@ namespace mpm
 
         const double        g_vertical = std::abs(parameters.gravity[dim - 1]);
         std::vector<double> properties(Layout::n_properties);
+        // One allocation of the property pool for all points (an upper bound on one rank's).
+        handler.reserve(handler.n_locally_owned_particles() + points.size());
         for (int i = 0; i < points.size(); ++i, ++id)
           {
             double x[dim];
@@ -234,9 +236,9 @@ namespace mpm
             for (int d = 0; d < dim; ++d)
               location[d] = x[d];
             const dealii::Point<dim> reference = grid.mapping.transform_real_to_unit_cell(cell, location);
-            dealii::Particles::Particle<dim> particle(location, reference, id);
-            auto it = handler.insert_particle(particle, cell);
-            it->set_properties(properties);
+            // Straight into the handler's pool, without a Particle and a second copy of the properties.
+            handler.insert_particle(location, reference, id, cell,
+                                    dealii::ArrayView<const double>(properties.data(), properties.size()));
           }
       }
     n_generated = id;
