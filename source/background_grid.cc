@@ -13,7 +13,10 @@ namespace mpm
   BackgroundGrid<dim>::BackgroundGrid(const Parameters &parameters, MPI_Comm communicator)
     : communicator(communicator)
     , n_ranks(dealii::Utilities::MPI::n_mpi_processes(communicator))
-    , triangulation(communicator)
+    , triangulation_storage(n_ranks > 1 ? std::make_unique<dealii::parallel::distributed::Triangulation<dim>>(communicator) :
+                                          std::make_unique<dealii::Triangulation<dim>>())
+    , triangulation(*triangulation_storage)
+    , distributed(dynamic_cast<dealii::parallel::distributed::Triangulation<dim> *>(&triangulation))
     , fe(1)
     , dof_handler(triangulation)
     , boundary(parameters.boundary)
@@ -86,7 +89,9 @@ namespace mpm
 
     // Cells for the per-cell sums of the pressure averaging: deal.II's partitioner of the
     // global active cell indices has the owned cells and the ghost layer.
-    cell_partitioner = triangulation.global_active_cell_index_partitioner().lock();
+    cell_partitioner = distributed ? distributed->global_active_cell_index_partitioner().lock() :
+                                     std::make_shared<const dealii::Utilities::MPI::Partitioner>(
+                                       triangulation.n_active_cells());
     lattice_cell_of_local_cell.assign(cell_partitioner->locally_owned_size() + cell_partitioner->n_ghost_indices(),
                                       -1);
 

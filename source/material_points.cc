@@ -191,6 +191,8 @@ namespace mpm
 
         const double        g_vertical = std::abs(parameters.gravity[dim - 1]);
         std::vector<double> properties(Layout::n_properties);
+        // One allocation of the property pool for all points (an upper bound on one rank's).
+        handler.reserve(handler.n_locally_owned_particles() + points.size());
         for (int i = 0; i < points.size(); ++i, ++id)
           {
             double x[dim];
@@ -234,9 +236,9 @@ namespace mpm
             for (int d = 0; d < dim; ++d)
               location[d] = x[d];
             const dealii::Point<dim> reference = grid.mapping.transform_real_to_unit_cell(cell, location);
-            dealii::Particles::Particle<dim> particle(location, reference, id);
-            auto it = handler.insert_particle(particle, cell);
-            it->set_properties(properties);
+            // Straight into the handler's pool, without a Particle and a second copy of the properties.
+            handler.insert_particle(location, reference, id, cell,
+                                    dealii::ArrayView<const double>(properties.data(), properties.size()));
           }
       }
     n_generated = id;
@@ -377,7 +379,8 @@ namespace mpm
   double MaterialPoints<dim>::imbalance() const
   {
     // The work model of the partition's cell weights: cells plus weighted points.
-    const double local = grid.triangulation.n_locally_owned_active_cells() +
+    const double local = (grid.distributed ? grid.distributed->n_locally_owned_active_cells() :
+                                             grid.triangulation.n_active_cells()) +
                          point_weight * static_cast<double>(handler.n_locally_owned_particles());
     const double most  = dealii::Utilities::MPI::max(local, grid.communicator);
     const double total = dealii::Utilities::MPI::sum(local, grid.communicator);
@@ -390,7 +393,8 @@ namespace mpm
     // As deal.II's step-68: the handler packs its points with their cells, p4est moves
     // cells by weight, the handler unpacks them on the new owners.
     handler.prepare_for_coarsening_and_refinement();
-    grid.triangulation.repartition();
+    Assert(grid.distributed, dealii::ExcInternalError()); // only called on several ranks
+    grid.distributed->repartition();
     handler.unpack_after_coarsening_and_refinement();
     grid.distribute_nodes();
   }

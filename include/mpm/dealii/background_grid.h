@@ -1,5 +1,5 @@
-// The background grid as deal.II sees it: a p4est triangulation of a uniform
-// Cartesian box, a Q1 DoFHandler whose vertex DoFs are the MPM nodes, nodal fields
+// The background grid as deal.II sees it: a triangulation of a uniform Cartesian box
+// (p4est on several ranks, a serial one on one rank), a Q1 DoFHandler whose vertex DoFs are the MPM nodes, nodal fields
 // as distributed vectors over the locally relevant DoFs, and the lattice lookup and
 // boundary masks that the core's GridView reads.
 //
@@ -74,7 +74,12 @@ namespace mpm
 
     MPI_Comm                                  communicator;
     unsigned int                              n_ranks;
-    dealii::parallel::distributed::Triangulation<dim> triangulation;
+    // p4est on several ranks. On one rank a serial Triangulation: the same cells in the same
+    // order and the same node numbering, without p4est's 2:1 balance and copy of the forest
+    // at each refinement (1.4 s of the 3D granular collapse set-up, 230,400 cells).
+    std::unique_ptr<dealii::Triangulation<dim>>        triangulation_storage;
+    dealii::Triangulation<dim>                        &triangulation;
+    dealii::parallel::distributed::Triangulation<dim> *distributed; // null on one rank
     dealii::FE_Q<dim>                         fe;
     dealii::DoFHandler<dim>                   dof_handler;
     // The cells are axis-parallel cubes: real <-> unit coordinates are a shift and a
