@@ -2,8 +2,9 @@
 // (backend/cpu_backend.h): the stages of step.h hand their per-point / per-node
 // lambdas (MPM_HOST_DEVICE, compiled by nvcc with --extended-lambda) to
 //   for_each_node, gather_points : one thread per item, the item writes only itself;
-//   scatter_points                : one thread per point, nodal sums through add(),
-//                                   which is atomicAdd on the device (the order of the
+//   scatter_points                : one thread per point; a point's stencil sums through
+//                                   scatter_stencil, a cell's through add_to_node, both
+//                                   ending in atomicAdd on the device (the order of the
 //                                   additions, hence the rounding, varies from run to run);
 //   reduce_points                 : a two-pass tree reduction on the device; only the
 //                                   reduced value (a few bytes) crosses to the host.
@@ -187,7 +188,8 @@ namespace mpm
     }
 
     // Scatter adds (step.h): targets[k][entry] += values[k] for k < K, called by every
-    // point for each node (or cell) it adds into. On the device, lanes of a warp that
+    // point for the entry it adds into (the pressure averaging's cell sums; a point's
+    // stencil goes through scatter_stencil below). On the device, lanes of a warp that
     // add into the same entry in a run of neighbouring lanes sum their values first: the
     // run stages its K values per lane in shared memory, then lane j of the run sums value
     // j (j + length, ... for runs shorter than K) over the run's lanes and issues the one
@@ -505,7 +507,8 @@ namespace mpm
         MPM_CUDA_CHECK(cudaFuncGetAttributes(&attributes, cuda_detail::for_each_kernel<FT>));
         return attributes.maxThreadsPerBlock;
       }();
-      // Whole warps: add_to_node's lane arithmetic assumes lane = threadIdx.x % 32.
+      // Whole warps: the lane arithmetic of add_to_node and scatter_stencil assumes
+      // lane = threadIdx.x % 32.
       const int threads = ((block_size < max_threads ? block_size : max_threads) / 32) * 32;
       const int blocks  = (n + threads - 1) / threads;
       begin_timing();
