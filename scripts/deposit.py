@@ -201,24 +201,29 @@ def draw(result, png, title, reference):
     plt.close(fig)
 
 
-def main():
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+def add_arguments(parser, bin_help, png_help):
+    """The options of this script and of deposit_3d.py (the same reading, on slabs in 3D)."""
     parser.add_argument("output_dir")
     parser.add_argument("--index", type=int, default=-1, help="output number (default: the last)")
     parser.add_argument("--wall", type=float, default=0.0, help="x of the wall (m)")
     parser.add_argument("--base", type=float, default=0.0, help="height of the base (m)")
-    parser.add_argument("--bin", type=float, default=0.0025, help="column width (m), e.g. the cell size")
+    parser.add_argument("--bin", type=float, default=0.0025, help=bin_help)
     parser.add_argument("--fit-low", type=float, default=0.1)
     parser.add_argument("--fit-high", type=float, default=0.9)
     parser.add_argument("--failure-threshold", type=float, default=1e-3, help="displacement (m)")
     parser.add_argument("--min-thickness", type=float, help="toe: least deposit height (m); default --bin")
-    parser.add_argument("--png", help="picture of the deposit")
-    parser.add_argument("--title", default="")
+    parser.add_argument("--png", help=png_help)
     parser.add_argument("--reference", action="store_true", help="draw the V3 experiment (Bui et al. 2008)")
     parser.add_argument("--json", help="write the numbers here")
     parser.add_argument("--toe", type=mpm_results.bounds)
     parser.add_argument("--top-left", type=mpm_results.bounds)
     parser.add_argument("--slope", type=mpm_results.bounds)
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    add_arguments(parser, "column width (m), e.g. the cell size", "picture of the deposit")
+    parser.add_argument("--title", default="")
     args = parser.parse_args()
 
     data = mpm_results.particles_at(args.output_dir, args.index)

@@ -69,21 +69,7 @@ def measure_3d(data, wall, base, width, fit_low, fit_high, threshold, min_thickn
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("output_dir")
-    parser.add_argument("--index", type=int, default=-1, help="output number (default: the last)")
-    parser.add_argument("--wall", type=float, default=0.0)
-    parser.add_argument("--base", type=float, default=0.0)
-    parser.add_argument("--bin", type=float, default=0.0025, help="column and slab width (m), e.g. the cell size")
-    parser.add_argument("--fit-low", type=float, default=0.1)
-    parser.add_argument("--fit-high", type=float, default=0.9)
-    parser.add_argument("--failure-threshold", type=float, default=1e-3)
-    parser.add_argument("--min-thickness", type=float)
-    parser.add_argument("--png", help="picture of the mid-plane deposit")
-    parser.add_argument("--reference", action="store_true", help="draw the V3 experiment (Bui et al. 2008)")
-    parser.add_argument("--json")
-    parser.add_argument("--toe", type=mpm_results.bounds)
-    parser.add_argument("--top-left", type=mpm_results.bounds)
-    parser.add_argument("--slope", type=mpm_results.bounds)
+    deposit.add_arguments(parser, "column and slab width (m), e.g. the cell size", "picture of the mid-plane deposit")
     args = parser.parse_args()
 
     data = mpm_results.particles_at(args.output_dir, args.index)

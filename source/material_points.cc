@@ -393,7 +393,8 @@ namespace mpm
     // As deal.II's step-68: the handler packs its points with their cells, p4est moves
     // cells by weight, the handler unpacks them on the new owners.
     handler.prepare_for_coarsening_and_refinement();
-    Assert(grid.distributed, dealii::ExcInternalError()); // only called on several ranks
+    AssertThrow(grid.distributed != nullptr,
+                dealii::ExcMessage("repartition needs the distributed grid of a run on several ranks"));
     grid.distributed->repartition();
     handler.unpack_after_coarsening_and_refinement();
     grid.distribute_nodes();

@@ -115,9 +115,6 @@ namespace mpm
       permute(backend, original);
     }
 
-    // original_index()[slot]: the index the point in that slot had at the last reset().
-    const DeviceArray<int> &original_index() const { return original; }
-
     // Every point array copied to the host in the reference order: put back in that order
     // on the device (into the scratch array), then downloaded. Output does this every 0.1 s
     // of P2; on the host the scattered writes of 512,000 points' arrays took longer.
