@@ -84,6 +84,17 @@ namespace mpm
   } // namespace
 #endif
 
+  std::future<void> start_cuda_initialisation()
+  {
+#ifdef MPM_CUDA_ENGINE
+    return std::async(std::launch::async, [] { cuda::initialise_device(); });
+#else
+    std::promise<void> nothing_to_do;
+    nothing_to_do.set_value();
+    return nothing_to_do.get_future();
+#endif
+  }
+
   template <int dim>
   std::unique_ptr<Engine<dim>> make_cuda_engine(BackgroundGrid<dim> &grid,
                                                 const std::vector<MaterialParameters<double>> &materials,

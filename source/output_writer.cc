@@ -3,7 +3,6 @@
 #include <deal.II/base/exceptions.h>
 #include <deal.II/base/mpi.h>
 #include <deal.II/base/utilities.h>
-#include <deal.II/numerics/data_out.h>
 
 #include <chrono>
 #include <filesystem>
@@ -56,42 +55,6 @@ namespace mpm
       std::ofstream pvd(directory + "/" + name + ".pvd");
       dealii::DataOutBase::write_pvd_record(pvd, records);
     }
-
-    // Patches, names and vector ranges owned by value: one piece of a DataOut's patches.
-    template <int dim>
-    class GridPiece : public dealii::DataOutInterface<dim, dim>
-    {
-    public:
-      std::vector<dealii::DataOutBase::Patch<dim, dim>> patches;
-      std::vector<std::string>                          names;
-      Ranges                                            ranges;
-
-    protected:
-      const std::vector<dealii::DataOutBase::Patch<dim, dim>> &get_patches() const override { return patches; }
-      std::vector<std::string> get_dataset_names() const override { return names; }
-      Ranges                   get_nonscalar_data_ranges() const override { return ranges; }
-    };
-
-    // DataOut whose built patches can be split into pieces (each written on its own thread).
-    template <int dim>
-    class GridDataOut : public dealii::DataOut<dim>
-    {
-    public:
-      std::vector<GridPiece<dim>> split(const unsigned int n_pieces)
-      {
-        std::vector<GridPiece<dim>> pieces(n_pieces);
-        const std::size_t           n = this->patches.size();
-        for (unsigned int k = 0; k < n_pieces; ++k)
-          {
-            pieces[k].names  = this->get_dataset_names();
-            pieces[k].ranges = this->get_nonscalar_data_ranges();
-            pieces[k].patches.assign(std::make_move_iterator(this->patches.begin() + n * k / n_pieces),
-                                     std::make_move_iterator(this->patches.begin() + n * (k + 1) / n_pieces));
-          }
-        this->patches.clear();
-        return pieces;
-      }
-    };
 
     // Runs the tasks on their own threads and waits for all; rethrows the first error.
     void run_all(std::vector<std::function<void()>> &tasks)
@@ -164,6 +127,58 @@ namespace mpm
         }
     }
   } // namespace
+
+  template <int dim>
+  GridSnapshot<dim>::GridSnapshot(const BackgroundGrid<dim> &grid, const unsigned int rank)
+    : rank(rank)
+  {
+    for (const auto &cell : grid.dof_handler.active_cell_iterators())
+      if (cell->is_locally_owned())
+        cells.push_back(cell);
+    nodal.push_back(grid.mass);
+    for (int d = 0; d < dim; ++d)
+      nodal.push_back(grid.velocity[d]);
+    for (auto &field : nodal)
+      field.update_ghost_values(); // as DataOut::add_data_vector's copy does
+  }
+
+  template <int dim>
+  void GridDataOut<dim>::build_patches(const GridSnapshot<dim> &snapshot, const int begin, const int end)
+  {
+    constexpr unsigned int n_vertices = dealii::GeometryInfo<dim>::vertices_per_cell;
+    const int              last       = end < 0 ? static_cast<int>(snapshot.cells.size()) : end;
+    const unsigned int     n_nodal    = snapshot.nodal.size();
+    patches.clear();
+    patches.resize(std::max(last - begin, 0));
+    for (int c = begin; c < last; ++c)
+      {
+        const auto &cell  = snapshot.cells[c];
+        auto       &patch = patches[c - begin];
+        patch.patch_index    = c - begin;
+        patch.reference_cell = dealii::ReferenceCells::get_hypercube<dim>();
+        patch.data.reinit(n_nodal + 1, n_vertices);
+        // DataOut's points of a patch without subdivisions are the cell's vertices in
+        // deal.II's (lexicographic) vertex order.
+        for (unsigned int v = 0; v < n_vertices; ++v)
+          {
+            patch.vertices[v]                         = cell->vertex(v);
+            const dealii::types::global_dof_index dof = cell->vertex_dof_index(v, 0);
+            for (unsigned int k = 0; k < n_nodal; ++k)
+              patch.data(k, v) = snapshot.nodal[k](dof);
+            patch.data(n_nodal, v) = snapshot.rank;
+          }
+      }
+  }
+
+  template <int dim>
+  std::vector<std::string> GridDataOut<dim>::get_dataset_names() const
+  {
+    std::vector<std::string> names = {"nodal_mass"};
+    for (int d = 0; d < dim; ++d)
+      names.push_back(std::string("nodal_velocity_") + "xyz"[d]);
+    names.push_back("subdomain");
+    return names;
+  }
 
   template <int dim>
   void PointDataOut<dim>::build_patches(const PointSnapshot<dim> &snapshot, const int begin, const int end)
@@ -315,18 +330,10 @@ namespace mpm
     // ghosted copy of each vector (MPI: here, on this thread); build_patches then reads
     // those copies and the DoFHandler as it is (it changes only in a repartition, which
     // calls finish() first) and does no communication.
-    std::shared_ptr<GridDataOut<dim>> grid_out;
+    std::shared_ptr<const GridSnapshot<dim>> grid_snapshot;
     if (write_grid)
       {
-        grid_out = std::make_shared<GridDataOut<dim>>();
-        grid_out->attach_dof_handler(grid.dof_handler);
-        grid_out->add_data_vector(grid.mass, "nodal_mass");
-        const char *names[3] = {"nodal_velocity_x", "nodal_velocity_y", "nodal_velocity_z"};
-        for (int d = 0; d < dim; ++d)
-          grid_out->add_data_vector(grid.velocity[d], names[d]);
-        dealii::Vector<float> subdomain(grid.triangulation.n_active_cells());
-        subdomain = rank;
-        grid_out->add_data_vector(subdomain, "subdomain");
+        grid_snapshot = std::make_shared<const GridSnapshot<dim>>(grid, rank);
         grid_records.emplace_back(time, record_name("grid", counter));
       }
     if (write_particles)
@@ -335,14 +342,15 @@ namespace mpm
     // Two tasks, each reading only what it owns (the snapshot is not touched until finish());
     // each writes its Output/Files per rank pieces on as many threads.
     const unsigned int K = pieces_per_rank;
-    auto grid_task = [this, grid_out, K, counter = counter, records = grid_records]() {
-      grid_out->build_patches();
-      auto                               pieces = grid_out->split(K);
+    auto grid_task = [this, grid_snapshot, K, counter = counter, records = grid_records]() {
       std::vector<std::function<void()>> writes;
+      const int                          n = grid_snapshot->cells.size();
       for (unsigned int k = 0; k < K; ++k)
         writes.emplace_back([&, k]() {
-          pieces[k].set_flags(vtk_flags);
-          write_piece(pieces[k], output_directory, "grid", counter, rank * K + k, n_ranks * K, rank == 0 && k == 0,
+          GridDataOut<dim> out;
+          out.set_flags(vtk_flags);
+          out.build_patches(*grid_snapshot, int(long(n) * k / K), int(long(n) * (k + 1) / K));
+          write_piece(out, output_directory, "grid", counter, rank * K + k, n_ranks * K, rank == 0 && k == 0,
                       records);
         });
       run_all(writes);
@@ -412,6 +420,10 @@ namespace mpm
     history.flush();
   }
 
+  template struct GridSnapshot<2>;
+  template struct GridSnapshot<3>;
+  template class GridDataOut<2>;
+  template class GridDataOut<3>;
   template class OutputWriter<2>;
   template class OutputWriter<3>;
 } // namespace mpm

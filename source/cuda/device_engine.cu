@@ -33,6 +33,12 @@ namespace mpm
       return n;
     }
 
+    void initialise_device()
+    {
+      if (cudaFree(nullptr) != cudaSuccess)
+        (void)cudaGetLastError(); // reported again, with context, by device_count()
+    }
+
     std::string device_description()
     {
       int device = 0;
@@ -97,6 +103,8 @@ namespace mpm
       long                         n_lattice_cells = 1;
       ShapeFunction                shape;
       ExchangeAdapter              exchange;
+      // Host node number of each device node, where the device renumbered them (empty: same numbering).
+      std::vector<int>             host_node_of_device_node;
     };
 
     template <int dim>
@@ -122,9 +130,37 @@ namespace mpm
           n_lattice_nodes *= g.n_cells[d] + 1;
           impl->n_lattice_cells *= g.n_cells[d];
         }
-      host.lattice_to_node.assign(g.lattice_to_node, g.lattice_to_node + n_lattice_nodes);
+      // Without an exchange the device may number its nodes as it likes. Where the host's
+      // nodes are the whole lattice (one rank), the device keeps them in lattice order, x
+      // fastest: the 3 x-neighbours of a stencil row then share a cache sector, and the
+      // points of a sorted warp read and add into nearby addresses (deal.II numbers the
+      // DoFs cell by cell). download_nodal puts the values back in the host's order.
+      std::vector<int> lattice_nodes(g.lattice_to_node, g.lattice_to_node + n_lattice_nodes);
+      bool             bijection = exchange == nullptr && g.n_nodes == n_lattice_nodes;
+      std::vector<char> seen(bijection ? g.n_nodes : 0, 0);
+      for (long l = 0; bijection && l < n_lattice_nodes; ++l)
+        {
+          const int node = lattice_nodes[l];
+          bijection      = node >= 0 && node < g.n_nodes && !seen[node];
+          if (bijection)
+            seen[node] = 1;
+        }
       host.allocate_nodes(g.n_nodes);
-      host.fixed_components.assign(g.fixed_components, g.fixed_components + g.n_nodes);
+      if (bijection)
+        {
+          impl->host_node_of_device_node = lattice_nodes;
+          host.lattice_to_node.resize(n_lattice_nodes);
+          for (long l = 0; l < n_lattice_nodes; ++l)
+            {
+              host.lattice_to_node[l]     = static_cast<int>(l);
+              host.fixed_components[l] = g.fixed_components[lattice_nodes[l]];
+            }
+        }
+      else
+        {
+          host.lattice_to_node = lattice_nodes;
+          host.fixed_components.assign(g.fixed_components, g.fixed_components + g.n_nodes);
+        }
       impl->grid.upload(host);
       impl->materials.upload(materials);
       impl->exchange = ExchangeAdapter{exchange, g.n_nodes};
@@ -164,12 +200,24 @@ namespace mpm
       const size_t bytes = dg.mass.bytes();
       if (static_cast<size_t>(g.n_nodes) != dg.mass.size())
         throw std::invalid_argument("DeviceEngine::download_nodal: the host grid has another number of nodes");
-      MPM_CUDA_CHECK(cudaMemcpy(g.mass, dg.mass.data(), bytes, cudaMemcpyDeviceToHost));
+      const std::vector<int> &host_node = impl->host_node_of_device_node;
+      std::vector<double>     staging(host_node.empty() ? 0 : dg.mass.size());
+      auto download = [&](double *to, const DeviceArray<double> &from) {
+        if (host_node.empty())
+          {
+            MPM_CUDA_CHECK(cudaMemcpy(to, from.data(), bytes, cudaMemcpyDeviceToHost));
+            return;
+          }
+        MPM_CUDA_CHECK(cudaMemcpy(staging.data(), from.data(), bytes, cudaMemcpyDeviceToHost));
+        for (size_t k = 0; k < staging.size(); ++k)
+          to[host_node[k]] = staging[k];
+      };
+      download(g.mass, dg.mass);
       for (int d = 0; d < dim; ++d)
         {
-          MPM_CUDA_CHECK(cudaMemcpy(g.momentum[d], dg.momentum[d].data(), bytes, cudaMemcpyDeviceToHost));
-          MPM_CUDA_CHECK(cudaMemcpy(g.force[d], dg.force[d].data(), bytes, cudaMemcpyDeviceToHost));
-          MPM_CUDA_CHECK(cudaMemcpy(g.velocity[d], dg.velocity[d].data(), bytes, cudaMemcpyDeviceToHost));
+          download(g.momentum[d], dg.momentum[d]);
+          download(g.force[d], dg.force[d]);
+          download(g.velocity[d], dg.velocity[d]);
         }
     }
 

@@ -8,11 +8,15 @@
 //  - the .pvtu records are the same;
 //  - pieces of consecutive point ranges (Output/Files per rank) add up to the whole, and an
 //    empty piece is a valid file.
+// The grid files (GridSnapshot + GridDataOut) are the same file as deal.II's DataOut writes
+// for the nodal vectors and the rank as cell data, byte for byte, and their pieces add up
+// to the whole.
 // Runs on any number of MPI ranks (each rank compares its own piece).
 #include <mpm/dealii/material_points.h>
 #include <mpm/dealii/output_writer.h>
 
 #include <deal.II/base/mpi.h>
+#include <deal.II/numerics/data_out.h>
 #include <deal.II/particles/data_out.h>
 
 #include "../core/check.h"
@@ -89,6 +93,53 @@ namespace
     return s.str();
   }
 
+  // Grid output: distinct nodal values per DoF and field, DataOut against GridDataOut.
+  template <int dim>
+  void check_grid(BackgroundGrid<dim> &grid)
+  {
+    const unsigned int rank = dealii::Utilities::MPI::this_mpi_process(MPI_COMM_WORLD);
+    auto fill = [](auto &vector, const double field) {
+      for (const auto i : vector.locally_owned_elements())
+        vector(i) = field + 0.25 * i + 1e-3 * (i % 7);
+      vector.update_ghost_values();
+    };
+    fill(grid.mass, 1000);
+    for (int d = 0; d < dim; ++d)
+      fill(grid.velocity[d], -100.0 * (d + 1));
+
+    dealii::DataOut<dim> reference;
+    reference.attach_dof_handler(grid.dof_handler);
+    reference.add_data_vector(grid.mass, "nodal_mass");
+    const char *names[3] = {"nodal_velocity_x", "nodal_velocity_y", "nodal_velocity_z"};
+    for (int d = 0; d < dim; ++d)
+      reference.add_data_vector(grid.velocity[d], names[d]);
+    dealii::Vector<float> subdomain(grid.triangulation.n_active_cells());
+    subdomain = rank;
+    reference.add_data_vector(subdomain, "subdomain");
+    reference.build_patches();
+
+    const GridSnapshot<dim> snapshot(grid, rank);
+    GridDataOut<dim>        direct;
+    direct.build_patches(snapshot);
+    mpm_test::check(snapshot.cells.size() > 4, "the grid has cells on this rank");
+    mpm_test::check(vtu(reference) == vtu(direct), dim == 2 ? "2D: same grid .vtu as DataOut's" :
+                                                              "3D: same grid .vtu as DataOut's");
+
+    const int                 n = snapshot.cells.size();
+    Exposed<GridDataOut<dim>> whole, first, second;
+    whole.build_patches(snapshot);
+    first.build_patches(snapshot, 0, n / 3);
+    second.build_patches(snapshot, n / 3, n);
+    bool same = first.get_patches().size() + second.get_patches().size() == whole.get_patches().size();
+    for (unsigned int i = 0; same && i < whole.get_patches().size(); ++i)
+      {
+        const auto &piece = i < first.get_patches().size() ? first.get_patches()[i] :
+                                                             second.get_patches()[i - first.get_patches().size()];
+        same = piece.vertices[0] == whole.get_patches()[i].vertices[0] && piece.data == whole.get_patches()[i].data;
+      }
+    mpm_test::check(same, "two grid pieces hold the cells of the whole, in order");
+  }
+
   template <int dim>
   void check_dim()
   {
@@ -145,6 +196,8 @@ namespace
       const std::string file = vtu(empty);
       mpm_test::check(file.find("NumberOfPoints=\"0\"") != std::string::npos, "an empty piece is a file without points");
     }
+
+    check_grid(grid);
 
     // A point that left the grid: marked in the engine's arrays, removed from the handler
     // (which reorders the points of that cell): the same patches, matched by id.

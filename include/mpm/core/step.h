@@ -417,6 +417,20 @@ namespace mpm
           HostStencil<dim, Shape, Real>(g, x, lp).for_each(g, visit);
 #endif
 
+        // The position first: x and dx are then dead before the constitutive update, the
+        // largest live state of the kernel (the CUDA gathers run under a register cap).
+        bool leaves_grid = false;
+        if (move_points)
+          for (int d = 0; d < dim; ++d)
+            {
+              const Real xn      = x[d] + dt * dx[d];
+              p.position[d][i]   = xn;
+              const Real s_local = (xn - g.origin[d]) / g.h;
+              // Also catches NaN, which compares false.
+              if (!(s_local >= Real(0) && s_local <= Real(g.n_cells[d])))
+                leaves_grid = true;
+            }
+
         if (deform_points)
           {
             Mat3<Real> dF = Mat3<Real>::identity(), dW;
@@ -474,21 +488,8 @@ namespace mpm
               }
           }
 
-        if (move_points)
-          {
-            bool inside = true;
-            for (int d = 0; d < dim; ++d)
-              {
-                const Real xn      = x[d] + dt * dx[d];
-                p.position[d][i]   = xn;
-                const Real s_local = (xn - g.origin[d]) / g.h;
-                // Also catches NaN, which compares false.
-                if (!(s_local >= Real(0) && s_local <= Real(g.n_cells[d])))
-                  inside = false;
-              }
-            if (!inside)
-              p.material[i] = -1;
-          }
+        if (leaves_grid)
+          p.material[i] = -1;
       });
     }
 

@@ -29,6 +29,11 @@ namespace mpm
     // driver); on 0, `why` says what the runtime reported.
     int device_count(std::string *why = nullptr);
 
+    // Creates the CUDA context of the current device now (driver load and context: a few
+    // tenths of a second), so that a thread can do it while the host builds the grid.
+    // Errors are left for the engine's constructor to report.
+    void initialise_device();
+
     // Name, compute capability and memory of the current device, for the log.
     std::string device_description();
 

@@ -4,11 +4,18 @@
 
 #include <mpm/dealii/engine.h>
 
+#include <future>
+
 namespace mpm
 {
   // Throws naming Backend/Backend where this build has no CUDA engine
   // (configured without -DMPM_WITH_CUDA=ON), where no CUDA device is found, or on
   // more than one MPI rank (not supported by the CUDA engine yet).
+  // Starts creating the CUDA context on a thread of its own (where this build has the
+  // CUDA engine), so that it overlaps the set-up of the grid and the points; wait on the
+  // result before make_cuda_engine. A ready future in builds without CUDA.
+  std::future<void> start_cuda_initialisation();
+
   template <int dim>
   std::unique_ptr<Engine<dim>> make_cuda_engine(BackgroundGrid<dim> &grid,
                                                 const std::vector<MaterialParameters<double>> &materials,

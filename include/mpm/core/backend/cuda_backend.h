@@ -123,6 +123,9 @@ namespace mpm
     // max_stencil_threads lanes, 16-byte aligned for paired loads; and per warp a table
     // of its runs (head lane, length, first stencil node). One of each per kernel,
     // whichever scatters it instantiates.
+#if !defined(MPM_SKIP_ZERO_SUMS)
+#  define MPM_SKIP_ZERO_SUMS 1
+#endif
     constexpr int max_stencil_threads = 128;
     constexpr int max_record_values   = 34;
     constexpr int run_entry_ints      = 5; // head, length, first[3]
@@ -390,7 +393,12 @@ namespace mpm
           const int node = g.node(idx);
           if (node >= 0) // else absent, or outside the lattice where the weight is zero
             for (int v = 0; v < K; ++v)
-              atomicAdd(&targets[v][node], sum[v]);
+#if MPM_SKIP_ZERO_SUMS
+              // A GIMP weight is exactly zero where a point's domain ends at the node's
+              // support (points on their initial lattice sites, lp = h/4): adding 0 changes nothing.
+              if (sum[v] != Real(0))
+#endif
+                atomicAdd(&targets[v][node], sum[v]);
         }
       __syncwarp(); // the records and the run table are reused by the next call
 #else
