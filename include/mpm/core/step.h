@@ -137,10 +137,22 @@ namespace mpm
         }
     }
 
+    // Nodal sums to zero before a P2G pass; with cells_too also the pressure averaging's
+    // cell sums, in the same pass (one launch less on the device).
     template <int dim, typename Real, typename Backend>
-    void reset_grid(Backend &backend, const GridView<dim, Real> &g, const bool mass_too)
+    void reset_grid(Backend &backend, const GridView<dim, Real> &g, const bool mass_too, const bool cells_too = false)
     {
-      backend.for_each_node(g.n_nodes, [=] MPM_HOST_DEVICE(const int n) {
+      if (cells_too && (g.cell_volume == nullptr || g.cell_pressure_volume == nullptr))
+        throw std::invalid_argument("pressure averaging needs GridView::cell_volume and cell_pressure_volume");
+      const int n_cells = cells_too ? g.n_lattice_cells() : 0;
+      backend.for_each_node(g.n_nodes > n_cells ? g.n_nodes : n_cells, [=] MPM_HOST_DEVICE(const int n) {
+        if (n < n_cells)
+          {
+            g.cell_volume[n]          = Real(0);
+            g.cell_pressure_volume[n] = Real(0);
+          }
+        if (n >= g.n_nodes)
+          return;
         if (mass_too)
           g.mass[n] = Real(0);
         for (int d = 0; d < dim; ++d)
@@ -522,19 +534,17 @@ namespace mpm
     // of a lattice cell gets the volume-weighted mean pressure of the cell,
     //   p_c = sum_p V_p p_p / sum_p V_p,   sigma_p <- s_p - p_c I   (s_p deviatoric part kept),
     // with p = -tr(sigma)/3 (plane strain: sigma_zz included). Two passes through the
-    // backend: scatter V_p and V_p p_p into per-cell sums, then gather p_c back.
-    // The averaged stress is not returned to the yield surface again (ep2-3De neither).
-    // On several ranks, exchange.sum_cells sums the cells between the two passes.
+    // backend: scatter V_p and V_p p_p into per-cell sums (zeroed by reset_grid with
+    // cells_too), then gather p_c back (apply_cell_pressure, run by itself or inside the
+    // step's reduction). The averaged stress is not returned to the yield surface again
+    // (ep2-3De neither). On several ranks, exchange.sum_cells sums the cells between the
+    // two passes.
     template <int dim, typename Real, typename Backend, typename Exchange = NoGridExchange>
-    void average_cell_pressure(Backend &backend, const GridView<dim, Real> &g, const PointsView<dim, Real> &p,
+    void scatter_cell_pressure(Backend &backend, const GridView<dim, Real> &g, const PointsView<dim, Real> &p,
                                const Exchange &exchange = Exchange())
     {
       if (g.cell_volume == nullptr || g.cell_pressure_volume == nullptr)
         throw std::invalid_argument("pressure averaging needs GridView::cell_volume and cell_pressure_volume");
-      backend.for_each_node(g.n_lattice_cells(), [=] MPM_HOST_DEVICE(const int c) {
-        g.cell_volume[c]          = Real(0);
-        g.cell_pressure_volume[c] = Real(0);
-      });
       backend.scatter_points(p.n_points, [=] MPM_HOST_DEVICE(const int i) {
         if (p.material[i] < 0)
           return;
@@ -549,25 +559,51 @@ namespace mpm
       // not migrated yet sits less than a cell outside its home cell): sum over ranks.
       Real *cell_sums[2] = {g.cell_volume, g.cell_pressure_volume};
       sum_cells(exchange, cell_sums, 2, 0);
+    }
+
+    // The gather of the averaging for point i (not removed).
+    template <int dim, typename Real>
+    MPM_HOST_DEVICE inline void apply_cell_pressure(const GridView<dim, Real> &g, const PointsView<dim, Real> &p,
+                                                    const int i)
+    {
+      Real       mean;
+      const int  c     = cell_and_mean_stress(g, p, i, mean);
+      const Real shift = g.cell_pressure_volume[c] / g.cell_volume[c] - mean;
+      for (int k = 0; k < 3; ++k)
+        p.stress[k][i] += shift;
+    }
+
+    // Both passes, cell sums zeroed first (USF, whose averaging is not the step's last pass).
+    template <int dim, typename Real, typename Backend, typename Exchange = NoGridExchange>
+    void average_cell_pressure(Backend &backend, const GridView<dim, Real> &g, const PointsView<dim, Real> &p,
+                               const Exchange &exchange = Exchange())
+    {
+      if (g.cell_volume == nullptr || g.cell_pressure_volume == nullptr)
+        throw std::invalid_argument("pressure averaging needs GridView::cell_volume and cell_pressure_volume");
+      backend.for_each_node(g.n_lattice_cells(), [=] MPM_HOST_DEVICE(const int c) {
+        g.cell_volume[c]          = Real(0);
+        g.cell_pressure_volume[c] = Real(0);
+      });
+      scatter_cell_pressure(backend, g, p, exchange);
       backend.gather_points(p.n_points, [=] MPM_HOST_DEVICE(const int i) {
-        if (p.material[i] < 0)
-          return;
-        Real       mean;
-        const int  c     = cell_and_mean_stress(g, p, i, mean);
-        const Real shift = g.cell_pressure_volume[c] / g.cell_volume[c] - mean;
-        for (int k = 0; k < 3; ++k)
-          p.stress[k][i] += shift;
+        if (p.material[i] >= 0)
+          apply_cell_pressure(g, p, i);
       });
     }
 
+    // The step's reductions (largest speed, power of gravity). With apply_averaging, the
+    // same pass first gathers the cell pressure back into each point (reduce_points calls
+    // the per-point function exactly once per point): one pass over the points less.
     template <int dim, typename Real, typename Backend>
-    StepReduction<Real> reduce_step(Backend &backend, const PointsView<dim, Real> &p,
-                                    const StepSettings<dim, Real> &s)
+    StepReduction<Real> reduce_step(Backend &backend, const GridView<dim, Real> &g, const PointsView<dim, Real> &p,
+                                    const StepSettings<dim, Real> &s, const bool apply_averaging = false)
     {
       StepReduction<Real> init{Real(0), Real(0), Real(0)};
       return backend.reduce_points(
         p.n_points, init,
         [=] MPM_HOST_DEVICE(const int i) {
+          if (apply_averaging && p.material[i] >= 0)
+            apply_cell_pressure(g, p, i);
           StepReduction<Real> r{Real(0), Real(0), Real(0)};
           Real v2 = Real(0);
           for (int d = 0; d < dim; ++d)
@@ -621,7 +657,7 @@ namespace mpm
             if constexpr (has_point_scratch<Backend>::value)
               stencils = backend.point_scratch(p.n_points, sizeof(HostStencil<dim, Shape, Real>));
 #endif
-            reset_grid(backend, g, true);
+            reset_grid(backend, g, true, s.pressure_averaging);
             particles_to_grid<dim, Shape>(backend, g, p, s, true, true, stencils);
             exchange.sum_nodal(mass_and_momentum, dim + 1);
             exchange.sum_nodal(forces, dim);
@@ -634,12 +670,12 @@ namespace mpm
           if (s.pressure_averaging)
             {
               group_for_scatter<dim, Shape>(backend, g, p); // the points have moved
-              average_cell_pressure(backend, g, p, exchange);
+              scatter_cell_pressure(backend, g, p, exchange); // gathered back by reduce_step
             }
           break;
 
         case UpdateScheme::usl:
-          reset_grid(backend, g, true);
+          reset_grid(backend, g, true, s.pressure_averaging);
           particles_to_grid<dim, Shape>(backend, g, p, s, true, true);
           exchange.sum_nodal(mass_and_momentum, dim + 1);
           exchange.sum_nodal(forces, dim);
@@ -649,7 +685,7 @@ namespace mpm
           if (s.pressure_averaging)
             {
               group_for_scatter<dim, Shape>(backend, g, p); // the points have moved
-              average_cell_pressure(backend, g, p, exchange);
+              scatter_cell_pressure(backend, g, p, exchange); // gathered back by reduce_step
             }
           break;
 
@@ -670,7 +706,7 @@ namespace mpm
       }
     if constexpr (colours_scatter<Backend>::value)
       backend.ungroup(); // the points have moved: the next group_for_scatter checks the grouping again
-    return reduce_step(backend, p, s);
+    return reduce_step(backend, g, p, s, s.pressure_averaging && s.scheme != UpdateScheme::usf);
   }
 
   // Dispatch on the shape function chosen at run time.
