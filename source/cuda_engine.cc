@@ -75,6 +75,8 @@ namespace mpm
 
       void set_materials(const std::vector<MaterialParameters<double>> &m) override { device.set_materials(m); }
 
+      void set_sort_interval(const int steps) override { device.set_sort_interval(steps); }
+
     private:
       BackgroundGrid<dim>      &grid;
       cuda::DeviceEngine<dim>   device;

@@ -245,6 +245,10 @@ namespace mpm
     prm.declare_entry("Backend", "cpu", Patterns::Selection("cpu|cuda"),
                       "Where the MPM step runs: cpu (threads through TBB) or cuda (needs a build with "
                       "-DMPM_WITH_CUDA=ON and a CUDA device).");
+    prm.declare_entry("Sort interval", "20", Patterns::Integer(0),
+                      "cuda: the device re-sorts its points by stencil every this many steps (0: never), so "
+                      "that neighbouring threads add into the same nodes and sum before their atomics. Sorting "
+                      "costs about a third of a step; doc/performance.md has the measurements behind the default.");
     prm.leave_subsection();
   }
 
@@ -462,7 +466,8 @@ namespace mpm
     prm.leave_subsection();
 
     prm.enter_subsection("Backend");
-    backend = prm.get("Backend");
+    backend       = prm.get("Backend");
+    sort_interval = prm.get_integer("Sort interval");
     prm.leave_subsection();
   }
 

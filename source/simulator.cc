@@ -129,6 +129,7 @@ namespace mpm
     if (cuda_ready.valid())
       cuda_ready.get();
     auto engine = make_engine<dim>(parameters.backend, grid, materials, parameters.shape_function);
+    engine->set_sort_interval(parameters.sort_interval);
     engine->load(points);
     timer.leave_subsection();
 

@@ -34,6 +34,9 @@ namespace mpm
     // load/store, in cell units (max-norm); MPI runs re-sort before it gets unsafe.
     // An engine that does not track it makes MPI runs re-sort after every step.
     virtual double max_distance_outside_home_cells() { return std::numeric_limits<double>::infinity(); }
+    // Steps between re-sorts of the points (Backend/Sort interval); engines that do not
+    // re-sort ignore it.
+    virtual void set_sort_interval(int /*steps*/) {}
     // Replaces the material table (e.g. when plasticity is switched on).
     virtual void set_materials(const std::vector<MaterialParameters<double>> &materials) = 0;
   };

@@ -90,6 +90,7 @@ namespace mpm
 
     // Backend
     std::string backend;
+    int         sort_interval = 20; // cuda: steps between re-sorts of the points on the device
 
     // Declares every entry for a given dimension, number of bodies and material names.
     static void declare(dealii::ParameterHandler &prm, unsigned int dim, unsigned int n_bodies,
