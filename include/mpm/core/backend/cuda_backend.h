@@ -123,9 +123,6 @@ namespace mpm
     // max_stencil_threads lanes, 16-byte aligned for paired loads; and per warp a table
     // of its runs (head lane, length, first stencil node). One of each per kernel,
     // whichever scatters it instantiates.
-#if !defined(MPM_SKIP_ZERO_SUMS)
-#  define MPM_SKIP_ZERO_SUMS 1
-#endif
     constexpr int max_stencil_threads = 128;
     constexpr int max_record_values   = 34;
     constexpr int run_entry_ints      = 5; // head, length, first[3]
@@ -341,65 +338,113 @@ namespace mpm
       }
       __syncwarp();
 
-      for (int task = lane; task < n_runs * n_stencil; task += 32)
-        {
-          const int  run    = task / n_stencil;
-          const int  s      = task - run * n_stencil;
-          const int  k[3]   = {s % n, (s / n) % n, s / (n * n)};
-          const int *entry  = runs + run * cuda_detail::run_entry_ints;
-          const int  from   = entry[0];
-          const int  to     = from + entry[1];
-          Real       sum[K];
-          for (int v = 0; v < K; ++v)
-            sum[v] = Real(0);
-          for (int l = from; l < to; ++l)
-            {
-              const Real *record = records + l * stride;
-              Real        wk[dim], dwk[dim], grad[dim];
-              for (int d = 0; d < dim; ++d)
-                if (with_grad)
-                  {
-                    const Pair wp = reinterpret_cast<const Pair *>(record)[d * n + k[d]];
-                    wk[d]         = wp.x;
-                    dwk[d]        = wp.y;
-                  }
-                else
-                  {
-                    wk[d]  = record[d * n + k[d]];
-                    dwk[d] = Real(0);
-                  }
-              const Real N = stencil_weight_at<dim>(wk, dwk, inv_h, grad);
-              Real       coefficients[n_c_even];
-              for (int v = 0; v < n_c_even; v += 2)
+      // Sum over the points of a run (its table entry) of their values at stencil node k.
+      auto add_run = [&](const int *entry, const int k[3], Real sum[K]) {
+        const int from = entry[0];
+        const int to   = from + entry[1];
+        for (int l = from; l < to; ++l)
+          {
+            const Real *record = records + l * stride;
+            Real        wk[dim], dwk[dim], grad[dim];
+            for (int d = 0; d < dim; ++d)
+              if (with_grad)
                 {
-                  const Pair cp       = reinterpret_cast<const Pair *>(record + at_c)[v / 2];
-                  coefficients[v]     = cp.x;
-                  coefficients[v + 1] = cp.y;
+                  const Pair wp = reinterpret_cast<const Pair *>(record)[d * n + k[d]];
+                  wk[d]         = wp.x;
+                  dwk[d]        = wp.y;
                 }
-              StencilContribution<dim, K, Kg, Real> point;
-              for (int v = 0; v < K; ++v)
-                point.c_N[v] = coefficients[v];
-              for (int v = 0; v < Kg; ++v)
-                for (int e = 0; e < dim; ++e)
-                  point.c_grad[v][e] = coefficients[K + v * dim + e];
-              Real values[K];
-              point.values(N, grad, values);
-              for (int v = 0; v < K; ++v)
-                sum[v] += values[v];
-            }
-          int idx[dim];
-          for (int d = 0; d < dim; ++d)
-            idx[d] = entry[2 + d] + k[d];
-          const int node = g.node(idx);
-          if (node >= 0) // else absent, or outside the lattice where the weight is zero
+              else
+                {
+                  wk[d]  = record[d * n + k[d]];
+                  dwk[d] = Real(0);
+                }
+            const Real N = stencil_weight_at<dim>(wk, dwk, inv_h, grad);
+            Real       coefficients[n_c_even];
+            for (int v = 0; v < n_c_even; v += 2)
+              {
+                const Pair cp       = reinterpret_cast<const Pair *>(record + at_c)[v / 2];
+                coefficients[v]     = cp.x;
+                coefficients[v + 1] = cp.y;
+              }
+            StencilContribution<dim, K, Kg, Real> point;
             for (int v = 0; v < K; ++v)
-#if MPM_SKIP_ZERO_SUMS
-              // A GIMP weight is exactly zero where a point's domain ends at the node's
-              // support (points on their initial lattice sites, lp = h/4): adding 0 changes nothing.
-              if (sum[v] != Real(0))
+              point.c_N[v] = coefficients[v];
+            for (int v = 0; v < Kg; ++v)
+              for (int e = 0; e < dim; ++e)
+                point.c_grad[v][e] = coefficients[K + v * dim + e];
+            Real values[K];
+            point.values(N, grad, values);
+            for (int v = 0; v < K; ++v)
+              sum[v] += values[v];
+          }
+      };
+      // The sums of stencil node k of the run with this table entry into the grid; a GIMP
+      // weight is exactly zero where a point's domain ends at the node's support (points
+      // near their initial sites, lp = h/4), and adding 0 changes nothing.
+      auto flush = [&](const int *entry, const int k[3], const Real sum[K]) {
+        int idx[dim];
+        for (int d = 0; d < dim; ++d)
+          idx[d] = entry[2 + d] + k[d];
+        const int node = g.node(idx);
+        if (node >= 0) // else absent, or outside the lattice where the weight is zero
+          for (int v = 0; v < K; ++v)
+            if (sum[v] != Real(0))
+              atomicAdd(&targets[v][node], sum[v]);
+      };
+
+#if !defined(MPM_SCATTER_ROLLING)
+#  define MPM_SCATTER_ROLLING 1
 #endif
-                atomicAdd(&targets[v][node], sum[v]);
+      if constexpr (MPM_SCATTER_ROLLING && dim == 3 && n_stencil > 16 && n_stencil <= 32)
+        {
+          // 3D GIMP: lane s holds stencil node s while the warp goes through its runs in
+          // order. Sorted points come as runs along x (4 runs of 8 per warp in the bulk),
+          // and the next run along x shares two of its three node layers with this one: the
+          // lanes then pass their sums one node down x (shuffle) and only the layer that
+          // leaves sends its sums to the grid. About half the atomics of one per run and
+          // node, with the same sums per lane and the same broadcast reads of the records.
+          const int  s    = lane;
+          const bool mine = s < n_stencil;
+          const int  k[3] = {s % n, (s / n) % n, s / (n * n)};
+          Real       held[K];
+          for (int v = 0; v < K; ++v)
+            held[v] = Real(0);
+          for (int run = 0; run < n_runs; ++run)
+            {
+              const int *entry = runs + run * cuda_detail::run_entry_ints;
+              if (run > 0)
+                {
+                  const int *previous = entry - cuda_detail::run_entry_ints;
+                  const bool next_along_x =
+                    entry[2] == previous[2] + 1 && entry[3] == previous[3] && entry[4] == previous[4];
+                  if (mine && (!next_along_x || k[0] == 0))
+                    flush(previous, k, held);
+                  for (int v = 0; v < K; ++v)
+                    {
+                      const Real from_next = __shfl_down_sync(all, held[v], 1);
+                      held[v]              = next_along_x && k[0] < n - 1 ? from_next : Real(0);
+                    }
+                }
+              if (mine)
+                add_run(entry, k, held);
+            }
+          if (mine)
+            flush(runs + (n_runs - 1) * cuda_detail::run_entry_ints, k, held);
         }
+      else
+        // The warp's tasks (run, stencil node) dealt round robin to its lanes.
+        for (int task = lane; task < n_runs * n_stencil; task += 32)
+          {
+            const int  run   = task / n_stencil;
+            const int  s     = task - run * n_stencil;
+            const int  k[3]  = {s % n, (s / n) % n, s / (n * n)};
+            const int *entry = runs + run * cuda_detail::run_entry_ints;
+            Real       sum[K];
+            for (int v = 0; v < K; ++v)
+              sum[v] = Real(0);
+            add_run(entry, k, sum);
+            flush(entry, k, sum);
+          }
       __syncwarp(); // the records and the run table are reused by the next call
 #else
       add_contribution<CudaBackend>([&](auto &&visit) { for_each_stencil_node<dim, Shape>(g, x, lp, visit); }, targets,
