@@ -119,14 +119,13 @@ namespace mpm
       };
       if (inside)
         {
-          const int *nodes = grid.lattice_to_node + base;
           for (int s = 0; s < n_stencil; ++s)
             {
               const int k[3]   = {s % n, (s / n) % n, s / (n * n)};
               long      offset = 0;
               for (int d = 0; d < dim; ++d)
                 offset += k[d] * stride[d];
-              const int node = nodes[offset];
+              const int node = grid.node_of_lattice(base + offset);
               if (node >= 0) // absent from this rank's node set
                 visit_position(s, node);
             }
@@ -188,7 +187,7 @@ namespace mpm
           long offset = 0;
           for (int d = 0; d < dim; ++d)
             offset += k[d] * stride[d];
-          return grid.lattice_to_node[base + offset];
+          return grid.node_of_lattice(base + offset);
         }
       int idx[dim];
       for (int d = 0; d < dim; ++d)

@@ -19,7 +19,9 @@ namespace mpm
     Real origin[dim];           // lower corner of the grid
     Real h;                     // cell size, equal in every direction
     int  n_cells[dim];          // cells per direction
-    const int *lattice_to_node; // lattice index -> local node index, -1 if absent
+    // Lattice index -> local node index, -1 if absent. Null: the nodes are the whole
+    // lattice in lattice order (device grids on one rank), no lookup needed.
+    const int *lattice_to_node;
     int        n_nodes;         // local nodes (length of the arrays below)
 
     Real *mass;
@@ -67,7 +69,13 @@ namespace mpm
             return -1;
           lattice = lattice * (n_cells[d] + 1) + idx[d];
         }
-      return lattice_to_node[lattice];
+      return node_of_lattice(lattice);
+    }
+
+    // Local node index of a lattice index inside the lattice.
+    MPM_HOST_DEVICE int node_of_lattice(const long lattice) const
+    {
+      return lattice_to_node != nullptr ? lattice_to_node[lattice] : static_cast<int>(lattice);
     }
   };
 

@@ -140,6 +140,9 @@ namespace mpm
           velocity[d].upload(g.velocity[d]);
         }
       lattice_to_node.upload(g.lattice_to_node);
+      lattice_order = g.lattice_to_node.size() == g.mass.size();
+      for (size_t l = 0; lattice_order && l < g.lattice_to_node.size(); ++l)
+        lattice_order = g.lattice_to_node[l] == static_cast<int>(l);
       mass.upload(g.mass);
       fixed_components.upload(g.fixed_components);
     }
@@ -156,7 +159,16 @@ namespace mpm
       mass.download(g.mass);
     }
 
-    GridView<dim, Real> view() { return make_grid_view<dim, Real>(*this); }
+    // Whether the lookup is the identity over the whole lattice (the view then has none).
+    bool lattice_order = false;
+
+    GridView<dim, Real> view()
+    {
+      GridView<dim, Real> v = make_grid_view<dim, Real>(*this);
+      if (lattice_order)
+        v.lattice_to_node = nullptr;
+      return v;
+    }
   };
 
   // The material table the constitutive update indexes by p.material[i].
