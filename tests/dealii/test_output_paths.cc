@@ -212,7 +212,7 @@ namespace
     from_snapshot_after.build_patches(snapshot);
     const auto old_patches = by_id(from_handler_after.get_patches());
     const auto new_patches = by_id(from_snapshot_after.get_patches());
-    mpm_test::check(new_patches.size() + 1 == snapshot.points.size(), "a point that left the grid is left out");
+    mpm_test::check(static_cast<int>(new_patches.size()) + 1 == snapshot.points.size(), "a point that left the grid is left out");
     bool same = old_patches.size() == new_patches.size();
     for (unsigned int i = 0; same && i < old_patches.size(); ++i)
       same = old_patches[i]->vertices[0] == new_patches[i]->vertices[0] && old_patches[i]->data == new_patches[i]->data;

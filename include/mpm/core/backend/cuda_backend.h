@@ -255,7 +255,10 @@ namespace mpm
     // and issues one atomicAdd per value. So a point costs one node's weight products per
     // node, there is no per-node reduction, the L2 sees one atomic per run, node and
     // value, and runs cut by warp boundaries or of uneven length keep the lanes evenly
-    // busy. N and grad N come from stencil_weight_at and the values from
+    // busy. 3D GIMP (27 nodes) goes through the runs in order instead, lane s holding
+    // node s, and passes the sums of the layers that the next run along x shares down x
+    // (half the atomics; see the branch below). Sums that are exactly zero are not added.
+    // N and grad N come from stencil_weight_at and the values from
     // StencilContribution::values: the same arithmetic as the CPU. Points whose stencil
     // is not wholly inside the lattice are runs of one. A warp that is not fully
     // converged (a removed point, the last partial warp) or a block larger than the
