@@ -50,7 +50,9 @@ namespace mpm
           last[d] = grid.n_cells[d] * n;
         count *= (last[d] > first[d] ? last[d] - first[d] : 0);
       }
-    int added = 0;
+    // The sites inside first, then every point array resized once (one resize per point
+    // of about 40 arrays took 0.2 s for P2's 512,000 points).
+    std::vector<Real> sites;
     for (long k = 0; k < count; ++k)
       {
         long rest = k;
@@ -64,15 +66,19 @@ namespace mpm
         bool in_box = true;
         for (int d = 0; d < dim; ++d)
           in_box = in_box && x[d] > lower[d] && x[d] < upper[d];
-        if (!in_box || !inside(x))
-          continue;
-
-        const int i = points.size();
-        points.resize(i + 1);
-        const Real V = std::pow(dx, dim);
+        if (in_box && inside(x))
+          sites.insert(sites.end(), x, x + dim);
+      }
+    const int added = static_cast<int>(sites.size() / dim);
+    const int start = points.size();
+    points.resize(start + added);
+    const Real V = std::pow(dx, dim);
+    for (int j = 0; j < added; ++j)
+      {
+        const int i = start + j;
         for (int d = 0; d < dim; ++d)
           {
-            points.position[d][i]                   = x[d];
+            points.position[d][i]                   = sites[j * dim + d];
             points.velocity[d][i]                   = body.velocity[d];
             points.domain_half_length[d][i]         = Real(0.5) * dx;
             points.initial_domain_half_length[d][i] = Real(0.5) * dx;
@@ -83,7 +89,6 @@ namespace mpm
         points.mass[i]                              = body.density * V;
         points.plastic_strain[i]                    = Real(0);
         points.material[i]                          = body.material;
-        ++added;
       }
     return added;
   }
