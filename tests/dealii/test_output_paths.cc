@@ -22,6 +22,7 @@
 #include "../core/check.h"
 
 #include <algorithm>
+#include <iterator>
 #include <sstream>
 
 namespace
@@ -44,6 +45,22 @@ namespace
       sorted.push_back(&patch);
     std::sort(sorted.begin(), sorted.end(), [](const Patch *a, const Patch *b) { return a->data(0, 0) < b->data(0, 0); });
     return sorted;
+  }
+
+  // Whether the patches of two pieces, one after the other, are those of the whole
+  // (every vertex and every value).
+  template <typename Out>
+  bool pieces_make_whole(const Out &first, const Out &second, const Out &whole)
+  {
+    const auto &a = first.get_patches(), &b = second.get_patches(), &all = whole.get_patches();
+    bool        same = a.size() + b.size() == all.size();
+    for (unsigned int i = 0; same && i < all.size(); ++i)
+      {
+        const auto &piece = i < a.size() ? a[i] : b[i - a.size()];
+        same = std::equal(std::begin(piece.vertices), std::end(piece.vertices), std::begin(all[i].vertices)) &&
+               piece.data == all[i].data;
+      }
+    return same;
   }
 
   template <int dim>
@@ -130,14 +147,7 @@ namespace
     whole.build_patches(snapshot);
     first.build_patches(snapshot, 0, n / 3);
     second.build_patches(snapshot, n / 3, n);
-    bool same = first.get_patches().size() + second.get_patches().size() == whole.get_patches().size();
-    for (unsigned int i = 0; same && i < whole.get_patches().size(); ++i)
-      {
-        const auto &piece = i < first.get_patches().size() ? first.get_patches()[i] :
-                                                             second.get_patches()[i - first.get_patches().size()];
-        same = piece.vertices[0] == whole.get_patches()[i].vertices[0] && piece.data == whole.get_patches()[i].data;
-      }
-    mpm_test::check(same, "two grid pieces hold the cells of the whole, in order");
+    mpm_test::check(pieces_make_whole(first, second, whole), "two grid pieces hold the cells of the whole, in order");
   }
 
   template <int dim>
@@ -185,14 +195,7 @@ namespace
       first.build_patches(snapshot, 0, n / 3);
       second.build_patches(snapshot, n / 3, n);
       empty.build_patches(snapshot, n, n);
-      bool same = first.get_patches().size() + second.get_patches().size() == whole.get_patches().size();
-      for (unsigned int i = 0; same && i < whole.get_patches().size(); ++i)
-        {
-          const auto &piece = i < first.get_patches().size() ? first.get_patches()[i] :
-                                                               second.get_patches()[i - first.get_patches().size()];
-          same = piece.vertices[0] == whole.get_patches()[i].vertices[0] && piece.data == whole.get_patches()[i].data;
-        }
-      mpm_test::check(same, "two pieces hold the points of the whole, in order");
+      mpm_test::check(pieces_make_whole(first, second, whole), "two pieces hold the points of the whole, in order");
       const std::string file = vtu(empty);
       mpm_test::check(file.find("NumberOfPoints=\"0\"") != std::string::npos, "an empty piece is a file without points");
     }
