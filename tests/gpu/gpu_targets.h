@@ -14,6 +14,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <random>
 #include <vector>
 
 namespace mpm_test
@@ -144,31 +145,50 @@ namespace mpm_test
     return diff;
   }
 
-  // Reverse the order of the points (changes the order of every nodal sum on the CPU).
+  // The points in another order: entry k of the result is point order[k] of p (changes
+  // the order of every nodal sum on the CPU).
   template <int dim, typename Real>
-  mpm::HostPoints<dim, Real> reversed(const mpm::HostPoints<dim, Real> &p)
+  mpm::HostPoints<dim, Real> permuted(const mpm::HostPoints<dim, Real> &p, const std::vector<int> &order)
   {
     mpm::HostPoints<dim, Real> r = p;
-    auto flip = [](auto &v) { std::reverse(v.begin(), v.end()); };
-    for (int d = 0; d < dim; ++d)
-      {
-        flip(r.position[d]);
-        flip(r.velocity[d]);
-        flip(r.domain_half_length[d]);
-        flip(r.initial_domain_half_length[d]);
-      }
-    for (int c = 0; c < mpm::n_voigt; ++c)
-      {
-        flip(r.stress[c]);
-        flip(r.strain[c]);
-      }
-    for (int c = 0; c < dim * dim; ++c)
-      flip(r.deformation_gradient[c]);
-    flip(r.mass);
-    flip(r.volume);
-    flip(r.initial_volume);
-    flip(r.plastic_strain);
-    flip(r.material);
+    mpm::for_each_point_array<dim>(r, p, [&](auto &to, const auto &from) {
+      if (from.empty()) // an optional array (material_field) that the scene leaves out
+        return;
+      for (std::size_t k = 0; k < order.size(); ++k)
+        to[k] = from[order[k]];
+    });
     return r;
   }
+
+  // The inverse of permuted(., order): back in the original order.
+  inline std::vector<int> inverse_order(const std::vector<int> &order)
+  {
+    std::vector<int> inverse(order.size());
+    for (std::size_t k = 0; k < order.size(); ++k)
+      inverse[order[k]] = int(k);
+    return inverse;
+  }
+
+  // The reversed order of n points.
+  inline std::vector<int> reversed_order(const int n)
+  {
+    std::vector<int> order(n);
+    for (int k = 0; k < n; ++k)
+      order[k] = n - 1 - k;
+    return order;
+  }
+
+  // A reproducible random order of n points (std::mt19937 is specified exactly by the
+  // standard; the shuffle is written out because std::shuffle's algorithm is not).
+  inline std::vector<int> random_order(const int n, const unsigned seed)
+  {
+    std::vector<int> order(n);
+    for (int k = 0; k < n; ++k)
+      order[k] = k;
+    std::mt19937 random(seed);
+    for (int k = n - 1; k > 0; --k)
+      std::swap(order[k], order[random() % (k + 1)]);
+    return order;
+  }
+
 } // namespace mpm_test

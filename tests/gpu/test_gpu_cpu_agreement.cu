@@ -22,10 +22,14 @@
 // Local damping is the exception: f <- f - D |f| sign(v) is discontinuous where a nodal
 // velocity passes through zero, and a node whose velocity is zero up to round-off (a
 // symmetry plane, a wall-adjacent node) gets +-D|f| depending on the summation order.
-// Measured on the CPU alone with the slump scene (D = 0.1, 300 steps): reordering the
-// points changes velocities by 8e-9 of max |v| (4e-14 with D = 0). So the scenes run
-// without damping are held to 1e-10, and the damped ones (column D = 0.05, slump D = 0.1)
-// to max(1e-10, 100 x the CPU's own reordering spread).
+// So the scenes run without damping are held to 1e-10, and the damped ones (column
+// D = 0.05, slump D = 0.1) to max(1e-10, 100 x the CPU's own reordering spread).
+// That spread depends on which nodes happen to flip, so one reordering is a noisy
+// estimate of it. Measured on the CPU alone (P1 slump with Drucker-Prager, D = 0.1, 200
+// steps, worst field): the reversed order and eight random ones gave 1.3e-9 to 2.1e-8;
+// with the blended G2P vector (theory.md) the reversed order alone gave 2.4e-10 and the
+// same eight random ones 1.0e-9 to 2.1e-8, so one order can be a lucky one. The
+// spread is therefore taken as the largest over the reversed order and four random ones.
 // Drucker-Prager scenes are held like the damped ones: the choice between the elastic,
 // shear, tension and corner returns switches on inequalities, so a point at a switch
 // follows the order of the sums.
@@ -38,6 +42,34 @@ using namespace mpm;
 using namespace mpm_test;
 
 constexpr double tolerance = 1e-10;
+
+// Random orders, besides the reversed one, over which the CPU's reordering spread is taken.
+constexpr unsigned n_random_orders = 4;
+
+// The CPU's own sensitivity to the order of its sums: run(out, &start) runs the scene on
+// the CPU from the points of initial listed in another order (reversed, and
+// n_random_orders reproducible random ones); each result, put back in the original order,
+// is compared with the CPU run cpu. Returns the largest difference per field.
+template <int dim, typename Run>
+Difference cpu_reordering_spread(const HostPoints<dim, double> &initial, const HostPoints<dim, double> &cpu,
+                                 const double h, Run &&run)
+{
+  std::vector<std::vector<int>> orders{reversed_order(initial.size())};
+  for (unsigned seed = 1; seed <= n_random_orders; ++seed)
+    orders.push_back(random_order(initial.size(), seed));
+  Difference spread;
+  for (const std::vector<int> &order : orders)
+    {
+      HostPoints<dim, double>       out;
+      const HostPoints<dim, double> start = permuted(initial, order);
+      run(out, &start);
+      const Difference d = compare_points(cpu, permuted(out, inverse_order(order)), h);
+      spread.position    = std::max(spread.position, d.position);
+      spread.velocity    = std::max(spread.velocity, d.velocity);
+      spread.stress      = std::max(spread.stress, d.stress);
+    }
+  return spread;
+}
 
 template <int dim>
 void report(const char *scene, const Difference &gpu, const Difference &reordered, const long steps,
@@ -71,86 +103,80 @@ int main()
     {
       {
         // V1 column, 32 cells, 1000 steps (the ramp has started, points have moved)
-        const long          n = 1000;
-        HostPoints<2, double> cpu, rev, gpu, initial;
-        ColumnSetup setup{32};
+        const long            n = 1000;
+        HostPoints<2, double> cpu, gpu, initial;
+        ColumnSetup           setup{32};
         setup.max_steps = 0;
         elastic_column<GimpShape, CpuTarget>(setup, initial);
         setup.max_steps = n;
         elastic_column<GimpShape, CpuTarget>(setup, cpu, &initial);
-        const HostPoints<2, double> initial_rev = reversed(initial);
-        elastic_column<GimpShape, CpuTarget>(setup, rev, &initial_rev);
+        const Difference spread = cpu_reordering_spread(initial, cpu, 10.0 / 32, [&](auto &out, const auto *start) {
+          elastic_column<GimpShape, CpuTarget>(setup, out, start);
+        });
         elastic_column<GimpShape, CudaTarget>(setup, gpu, &initial);
-        report<2>("V1 column 32 cells (2D GIMP)", compare_points(cpu, gpu, 10.0 / 32),
-                  compare_points(cpu, reversed(rev), 10.0 / 32), n, true);
+        report<2>("V1 column 32 cells (2D GIMP)", compare_points(cpu, gpu, 10.0 / 32), spread, n, true);
         elastic_column<GimpShape, CudaSortedTarget>(setup, gpu, &initial);
-        report<2>("V1 column, GPU sorted every 7", compare_points(cpu, gpu, 10.0 / 32),
-                  compare_points(cpu, reversed(rev), 10.0 / 32), n, true);
+        report<2>("V1 column, GPU sorted every 7", compare_points(cpu, gpu, 10.0 / 32), spread, n, true);
       }
       {
         // V3 geometry, elastic, 600 steps of gravity applied at once
         const long            n = 600;
-        HostPoints<2, double> cpu, rev, gpu, initial;
+        HostPoints<2, double> cpu, gpu, initial;
         collapse<CpuTarget>(initial, 0);
         collapse<CpuTarget>(cpu, n, &initial);
-        const HostPoints<2, double> initial_rev = reversed(initial);
-        collapse<CpuTarget>(rev, n, &initial_rev);
+        const Difference spread = cpu_reordering_spread(
+          initial, cpu, 0.005, [&](auto &out, const auto *start) { collapse<CpuTarget>(out, n, start); });
         collapse<CudaTarget>(gpu, n, &initial);
-        report<2>("V3 collapse geometry, elastic (2D)", compare_points(cpu, gpu, 0.005),
-                  compare_points(cpu, reversed(rev), 0.005), n, false);
+        report<2>("V3 collapse geometry, elastic (2D)", compare_points(cpu, gpu, 0.005), spread, n, false);
         collapse<CudaSortedTarget>(gpu, n, &initial);
-        report<2>("V3 collapse, GPU sorted every 7", compare_points(cpu, gpu, 0.005),
-                  compare_points(cpu, reversed(rev), 0.005), n, false);
+        report<2>("V3 collapse, GPU sorted every 7", compare_points(cpu, gpu, 0.005), spread, n, false);
       }
       {
         // V3 with Drucker-Prager (c = 0, phi = 19.8 deg): the column yields from the start
         const long            n = 600;
-        HostPoints<2, double> cpu, rev, gpu, initial;
+        HostPoints<2, double> cpu, gpu, initial;
         collapse<CpuTarget>(initial, 0, nullptr, true);
         collapse<CpuTarget>(cpu, n, &initial, true);
-        const HostPoints<2, double> initial_rev = reversed(initial);
-        collapse<CpuTarget>(rev, n, &initial_rev, true);
+        const Difference spread = cpu_reordering_spread(
+          initial, cpu, 0.005, [&](auto &out, const auto *start) { collapse<CpuTarget>(out, n, start, true); });
         const double yielded = plastic_fraction(cpu);
         std::printf("V3 Drucker-Prager: %.1f%% of the points have yielded after %ld steps\n", 100 * yielded, n);
         check(yielded > 0.01, "V3 Drucker-Prager: the scene exercises the plastic return");
         collapse<CudaTarget>(gpu, n, &initial, true);
-        report<2>("V3 collapse, Drucker-Prager (2D)", compare_points(cpu, gpu, 0.005),
-                  compare_points(cpu, reversed(rev), 0.005), n, true);
+        report<2>("V3 collapse, Drucker-Prager (2D)", compare_points(cpu, gpu, 0.005), spread, n, true);
         collapse<CudaSortedTarget>(gpu, n, &initial, true);
-        report<2>("V3 collapse, DP, GPU sorted every 7", compare_points(cpu, gpu, 0.005),
-                  compare_points(cpu, reversed(rev), 0.005), n, true);
+        report<2>("V3 collapse, DP, GPU sorted every 7", compare_points(cpu, gpu, 0.005), spread, n, true);
       }
       {
         // P1 with ep2-3De's Drucker-Prager and softening, 2 cells across, 200 steps
         const long            n = 200;
-        HostPoints<3, double> cpu, rev, gpu, initial;
+        HostPoints<3, double> cpu, gpu, initial;
         slump<CpuTarget>(2, initial, 0, static_cast<const HostPoints<3, double> *>(nullptr), mpm_bench::P1::damping, true);
         slump<CpuTarget>(2, cpu, n, &initial, mpm_bench::P1::damping, true);
-        const HostPoints<3, double> initial_rev = reversed(initial);
-        slump<CpuTarget>(2, rev, n, &initial_rev, mpm_bench::P1::damping, true);
+        const Difference spread = cpu_reordering_spread(initial, cpu, mpm_bench::P1::h, [&](auto &out, const auto *start) {
+          slump<CpuTarget>(2, out, n, start, mpm_bench::P1::damping, true);
+        });
         std::printf("P1 Drucker-Prager: %.1f%% of the points have yielded after %ld steps\n",
                     100 * plastic_fraction(cpu), n);
         slump<CudaSortedTarget>(2, gpu, n, &initial, mpm_bench::P1::damping, true);
-        report<3>("P1/V5 slump, DP, GPU sorted every 7, D=0.1", compare_points(cpu, gpu, mpm_bench::P1::h),
-                  compare_points(cpu, reversed(rev), mpm_bench::P1::h), n, true);
+        report<3>("P1/V5 slump, DP, GPU sorted every 7, D=0.1", compare_points(cpu, gpu, mpm_bench::P1::h), spread, n,
+                  true);
       }
       for (const double damping : {0.0, mpm_bench::P1::damping})
         {
           // P1/V5 slump geometry, 2 cells across (10,024 points), 200 steps
           const long            n = 200;
-          HostPoints<3, double> cpu, rev, gpu, initial;
+          HostPoints<3, double> cpu, gpu, initial;
           slump<CpuTarget>(2, initial, 0);
           slump<CpuTarget>(2, cpu, n, &initial, damping);
-          const HostPoints<3, double> initial_rev = reversed(initial);
-          slump<CpuTarget>(2, rev, n, &initial_rev, damping);
+          const Difference spread = cpu_reordering_spread(
+            initial, cpu, mpm_bench::P1::h, [&](auto &out, const auto *start) { slump<CpuTarget>(2, out, n, start, damping); });
           slump<CudaTarget>(2, gpu, n, &initial, damping);
           report<3>(damping > 0 ? "P1/V5 slump 2 cells across, D=0.1" : "P1/V5 slump 2 cells across, D=0",
-                    compare_points(cpu, gpu, mpm_bench::P1::h), compare_points(cpu, reversed(rev), mpm_bench::P1::h),
-                    n, damping > 0);
+                    compare_points(cpu, gpu, mpm_bench::P1::h), spread, n, damping > 0);
           slump<CudaSortedTarget>(2, gpu, n, &initial, damping);
           report<3>(damping > 0 ? "P1/V5 slump, GPU sorted every 7, D=0.1" : "P1/V5 slump, GPU sorted every 7, D=0",
-                    compare_points(cpu, gpu, mpm_bench::P1::h), compare_points(cpu, reversed(rev), mpm_bench::P1::h),
-                    n, damping > 0);
+                    compare_points(cpu, gpu, mpm_bench::P1::h), spread, n, damping > 0);
         }
     }
   catch (const std::exception &e)

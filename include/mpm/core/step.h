@@ -246,9 +246,11 @@ namespace mpm
     }
 
     // Grid update: local damping f <- f - D |f| sign(v), boundary masks, explicit
-    // momentum update. Leaves the acceleration in force[] and v^{n+1} in velocity[], and
-    // p^{n+1} in momentum[], or zero where the next stage rebuilds the momentum from the
-    // points (MUSL's remap: one pass over the nodes less).
+    // momentum update. Leaves v^{n+1} in velocity[], p^{n+1} in momentum[] (or zero where
+    // the next stage rebuilds the momentum from the points: MUSL's remap, one pass over
+    // the nodes less), and in force[] the nodal part of the blended G2P velocity,
+    //   w = alpha dt a + (1 - alpha) v^{n+1}   (alpha = FLIP fraction, a = f / m),
+    // so that G2P gathers one nodal vector instead of two (updated_point_velocity).
     template <int dim, typename Real, typename Backend>
     void update_grid(Backend &backend, const GridView<dim, Real> &g, const StepSettings<dim, Real> &s,
                      const Real dt, const bool zero_momentum = false)
@@ -268,9 +270,10 @@ namespace mpm
             if (v != Real(0))
               f -= s.damping * std::fabs(f) * (v > Real(0) ? Real(1) : Real(-1));
             const Real p_new = g.momentum[d][n] + dt * f;
+            const Real v_new = p_new / m;
             g.momentum[d][n] = zero_momentum ? Real(0) : p_new;
-            g.velocity[d][n] = p_new / m;
-            g.force[d][n]    = f / m;
+            g.velocity[d][n] = v_new;
+            g.force[d][n]    = s.flip_fraction * (dt * (f / m)) + (Real(1) - s.flip_fraction) * v_new;
           }
       });
     }
@@ -289,34 +292,28 @@ namespace mpm
       });
     }
 
-    // G2P velocity of point i: FLIP v_p + dt sum N a_i, blended with PIC sum N v_i^{n+1}.
+    // G2P velocity of point i: FLIP v_p + dt sum N a_i blended with PIC sum N v_i^{n+1},
+    //   alpha (v_p + dt sum N a_i) + (1 - alpha) sum N v_i = alpha v_p + sum N w_i,
+    // with w_i = alpha dt a_i + (1 - alpha) v_i left in force[] by update_grid.
     // stencil(visit) visits the point's stencil nodes (for_each_stencil_node).
     template <int dim, typename Real, typename Stencil>
     MPM_HOST_DEVICE inline void updated_point_velocity(const GridView<dim, Real> &g, const PointsView<dim, Real> &p,
-                                                       const StepSettings<dim, Real> &s, const Real dt, const int i,
+                                                       const StepSettings<dim, Real> &s, const int i,
                                                        Stencil &&stencil, Real v_new[dim])
     {
-      Real       a[dim] = {}, v_pic[dim] = {};
-      const bool pic    = s.flip_fraction != Real(1); // pure FLIP reads no nodal velocity
+      Real nodal[dim] = {};
       stencil([&](const int n, const Real N, const Real *) {
         for (int d = 0; d < dim; ++d)
-          a[d] += N * g.force[d][n];
-        if (pic)
-          for (int d = 0; d < dim; ++d)
-            v_pic[d] += N * g.velocity[d][n];
+          nodal[d] += N * g.force[d][n];
       });
       for (int d = 0; d < dim; ++d)
-        {
-          const Real v_flip = p.velocity[d][i] + dt * a[d];
-          v_new[d]          = s.flip_fraction * v_flip + (Real(1) - s.flip_fraction) * v_pic[d];
-        }
+        v_new[d] = s.flip_fraction * p.velocity[d][i] + nodal[d];
     }
 
     // G2P velocity (USL, USF).
     template <int dim, typename Shape, typename Real, typename Backend>
     void grid_to_particle_velocity(Backend &backend, const GridView<dim, Real> &g,
-                                   const PointsView<dim, Real> &p, const StepSettings<dim, Real> &s,
-                                   const Real dt)
+                                   const PointsView<dim, Real> &p, const StepSettings<dim, Real> &s)
     {
       backend.gather_points(p.n_points, [=] MPM_HOST_DEVICE(const int i) {
         if (p.material[i] < 0)
@@ -328,7 +325,7 @@ namespace mpm
             lp[d] = p.domain_half_length[d][i];
           }
         updated_point_velocity<dim>(
-          g, p, s, dt, i, [&](auto &&visit) { for_each_stencil_node<dim, Shape>(g, x, lp, visit); }, v_new);
+          g, p, s, i, [&](auto &&visit) { for_each_stencil_node<dim, Shape>(g, x, lp, visit); }, v_new);
         for (int d = 0; d < dim; ++d)
           p.velocity[d][i] = v_new[d];
       });
@@ -342,7 +339,7 @@ namespace mpm
     template <int dim, typename Shape, typename Real, typename Backend>
     void grid_to_particle_velocity_and_remap(Backend &backend, const GridView<dim, Real> &g,
                                              const PointsView<dim, Real> &p, const StepSettings<dim, Real> &s,
-                                             const Real dt, const void *stencils = nullptr)
+                                             const void *stencils = nullptr)
     {
       backend.scatter_points(p.n_points, [=] MPM_HOST_DEVICE(const int i) {
         if (p.material[i] < 0)
@@ -365,7 +362,7 @@ namespace mpm
                                 (own = HostStencil<dim, Shape, Real>(g, x, lp), &own);
         auto stencil = [&](auto &&visit) { host_stencil->for_each(g, visit); };
 #endif
-        updated_point_velocity<dim>(g, p, s, dt, i, stencil, v_new);
+        updated_point_velocity<dim>(g, p, s, i, stencil, v_new);
         const Real m = p.mass[i];
         for (int d = 0; d < dim; ++d)
           {
@@ -662,7 +659,7 @@ namespace mpm
             exchange.sum_nodal(mass_and_momentum, dim + 1);
             exchange.sum_nodal(forces, dim);
             update_grid(backend, g, s, dt, true);
-            grid_to_particle_velocity_and_remap<dim, Shape>(backend, g, p, s, dt, stencils);
+            grid_to_particle_velocity_and_remap<dim, Shape>(backend, g, p, s, stencils);
             exchange.sum_nodal(momentum, dim);
             velocity_from_momentum(backend, g, s.mass_tolerance);
             grid_to_particle_kinematics<dim, Shape>(backend, g, p, materials, s, dt, true, true, stencils);
@@ -680,7 +677,7 @@ namespace mpm
           exchange.sum_nodal(mass_and_momentum, dim + 1);
           exchange.sum_nodal(forces, dim);
           update_grid(backend, g, s, dt);
-          grid_to_particle_velocity<dim, Shape>(backend, g, p, s, dt);
+          grid_to_particle_velocity<dim, Shape>(backend, g, p, s);
           grid_to_particle_kinematics<dim, Shape>(backend, g, p, materials, s, dt, true, true);
           if (s.pressure_averaging)
             {
@@ -700,7 +697,7 @@ namespace mpm
           particles_to_grid<dim, Shape>(backend, g, p, s, false, true);
           exchange.sum_nodal(forces, dim);
           update_grid(backend, g, s, dt);
-          grid_to_particle_velocity<dim, Shape>(backend, g, p, s, dt);
+          grid_to_particle_velocity<dim, Shape>(backend, g, p, s);
           grid_to_particle_kinematics<dim, Shape>(backend, g, p, materials, s, dt, true, false);
           break;
       }

@@ -26,7 +26,7 @@ namespace mpm
 
     Real *mass;
     Real *momentum[dim];
-    Real *force[dim];    // force, after the grid update: acceleration
+    Real *force[dim];    // force; after the grid update, the nodal part of G2P's velocity (update_grid)
     Real *velocity[dim]; // nodal velocity used by G2P kinematics
     const std::uint8_t *fixed_components; // bit d set: velocity component d is prescribed zero
 
