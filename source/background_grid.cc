@@ -10,6 +10,19 @@
 namespace mpm
 {
   template <int dim>
+  HostGrid<dim, double> lattice_geometry(const Parameters &parameters)
+  {
+    HostGrid<dim, double> lattice;
+    lattice.h = parameters.cell_size;
+    for (unsigned int d = 0; d < dim; ++d)
+      {
+        lattice.origin[d]  = parameters.lower[d];
+        lattice.n_cells[d] = static_cast<int>(std::lround((parameters.upper[d] - parameters.lower[d]) / lattice.h));
+      }
+    return lattice;
+  }
+
+  template <int dim>
   BackgroundGrid<dim>::BackgroundGrid(const Parameters &parameters, MPI_Comm communicator)
     : communicator(communicator)
     , n_ranks(dealii::Utilities::MPI::n_mpi_processes(communicator))
@@ -21,7 +34,8 @@ namespace mpm
     , dof_handler(triangulation)
     , boundary(parameters.boundary)
   {
-    h = parameters.cell_size;
+    const HostGrid<dim, double> lattice = lattice_geometry<dim>(parameters);
+    h = lattice.h;
     std::vector<unsigned int> repetitions(dim);
     dealii::Point<dim>        p1, p2;
     // p4est orders the coarse cells as given (lexicographically: a partition into
@@ -31,8 +45,8 @@ namespace mpm
     unsigned int levels = 10;
     for (unsigned int d = 0; d < dim; ++d)
       {
-        origin[d]  = parameters.lower[d];
-        n_cells[d] = static_cast<int>(std::lround((parameters.upper[d] - parameters.lower[d]) / h));
+        origin[d]  = lattice.origin[d];
+        n_cells[d] = lattice.n_cells[d];
         unsigned int twos = 0;
         while (twos < levels && (n_cells[d] >> twos) % 2 == 0)
           ++twos;
@@ -266,6 +280,8 @@ namespace mpm
 
   template class BackgroundGrid<2>;
   template class BackgroundGrid<3>;
+  template HostGrid<2, double> lattice_geometry<2>(const Parameters &);
+  template HostGrid<3, double> lattice_geometry<3>(const Parameters &);
   template void BackgroundGrid<2>::sum_nodal(double *const *, int) const;
   template void BackgroundGrid<3>::sum_nodal(double *const *, int) const;
   template void BackgroundGrid<2>::sum_nodal(float *const *, int) const;

@@ -125,17 +125,9 @@ namespace mpm
   } // namespace
 
   template <int dim>
-  void MaterialPoints<dim>::generate(const Parameters &parameters)
+  std::vector<GeneratedBody<dim>> generate_bodies(const Parameters &parameters)
   {
-    using Layout = PropertyLayout<dim>;
-    // Geometry of the lattice only: point generation needs no node arrays.
-    HostGrid<dim, double> lattice;
-    lattice.h = grid.h;
-    for (int d = 0; d < dim; ++d)
-      {
-        lattice.origin[d]  = grid.origin[d];
-        lattice.n_cells[d] = grid.n_cells[d];
-      }
+    const HostGrid<dim, double> lattice = lattice_geometry<dim>(parameters);
 
     // Random fields of material parameters, one per material that has one, over the grid.
     std::map<unsigned int, std::unique_ptr<GaussianRandomField<dim>>> fields;
@@ -144,17 +136,17 @@ namespace mpm
         {
           const RandomFieldParameters &rf = parameters.material_fields[m];
           std::array<double, dim>      lo, hi;
-          double                       spacing = grid.h;
+          double                       spacing = lattice.h;
           for (int d = 0; d < dim; ++d)
             {
-              lo[d]   = grid.origin[d];
-              hi[d]   = grid.origin[d] + grid.n_cells[d] * grid.h;
+              lo[d]   = lattice.origin[d];
+              hi[d]   = lattice.origin[d] + lattice.n_cells[d] * lattice.h;
               spacing = std::min(spacing, rf.correlation_length[d] / 4);
             }
           fields[m] = std::make_unique<GaussianRandomField<dim>>(rf, lo, hi, spacing);
         }
 
-    dealii::types::particle_index id = 0;
+    std::vector<GeneratedBody<dim>> bodies(parameters.bodies.size());
     for (unsigned int b = 0; b < parameters.bodies.size(); ++b)
       {
         const BodyParameters &body = parameters.bodies[b];
@@ -184,13 +176,51 @@ namespace mpm
             lower[dim - 1] = *std::min_element(pv.begin(), pv.end());
             upper[dim - 1] = *std::max_element(pv.begin(), pv.end());
           }
-        HostPoints<dim, double> points;
+        HostPoints<dim, double> &points = bodies[b].points;
         add_points(points, lattice, lower, upper, description, [&](const double *x) {
           return body.shape != "polygon" || inside_polygon(px, pv, x[0], x[dim - 1]);
         });
 
-        const double        g_vertical = std::abs(parameters.gravity[dim - 1]);
-        std::vector<double> properties(Layout::n_properties);
+        const double g_vertical = std::abs(parameters.gravity[dim - 1]);
+        const auto   field      = fields.find(parameters.body_material[b]);
+        for (int i = 0; i < points.size(); ++i)
+          {
+            double x[dim];
+            for (int d = 0; d < dim; ++d)
+              x[d] = points.position[d][i];
+            for (int c = 0; c < n_voigt; ++c)
+              points.stress[c][i] = 0;
+            if (body.initial_stress == "geostatic")
+              {
+                const double sv     = -g_vertical * overburden<dim>(parameters, x);
+                points.stress[0][i] = body.k0 * sv;
+                points.stress[1][i] = dim == 2 ? sv : body.k0 * sv;
+                points.stress[2][i] = dim == 2 ? body.k0 * sv : sv;
+              }
+            points.material_field[i] = 0;
+            if (field != fields.end())
+              {
+                std::array<double, dim> xa;
+                for (int d = 0; d < dim; ++d)
+                  xa[d] = x[d];
+                // A Gaussian field can go below zero: cohesion and modulus are kept positive.
+                const double v           = field->second->value(xa);
+                points.material_field[i] = std::max(v, 1e-3 * std::abs(parameters.material_fields[field->first].mean));
+              }
+          }
+      }
+    return bodies;
+  }
+
+  template <int dim>
+  void MaterialPoints<dim>::insert(const std::vector<GeneratedBody<dim>> &bodies)
+  {
+    using Layout = PropertyLayout<dim>;
+    dealii::types::particle_index id = 0;
+    std::vector<double>           properties(Layout::n_properties);
+    for (const GeneratedBody<dim> &body : bodies)
+      {
+        const HostPoints<dim, double> &points = body.points;
         // One allocation of the property pool for all points (an upper bound on one rank's).
         handler.reserve(handler.n_locally_owned_particles() + points.size());
         for (int i = 0; i < points.size(); ++i, ++id)
@@ -214,23 +244,10 @@ namespace mpm
                 properties[Layout::deformation_gradient + d * dim + d] = 1.0;
                 properties[Layout::initial_position + d]           = x[d];
               }
-            if (body.initial_stress == "geostatic")
-              {
-                const double sv = -g_vertical * overburden<dim>(parameters, x);
-                properties[Layout::stress + 0] = body.k0 * sv;
-                properties[Layout::stress + 1] = dim == 2 ? sv : body.k0 * sv;
-                properties[Layout::stress + 2] = dim == 2 ? body.k0 * sv : sv;
-              }
-            properties[Layout::material] = parameters.body_material[b];
-            if (const auto field = fields.find(parameters.body_material[b]); field != fields.end())
-              {
-                std::array<double, dim> xa;
-                for (int d = 0; d < dim; ++d)
-                  xa[d] = x[d];
-                // A Gaussian field can go below zero: cohesion and modulus are kept positive.
-                const double v = field->second->value(xa);
-                properties[Layout::material_field] = std::max(v, 1e-3 * std::abs(parameters.material_fields[field->first].mean));
-              }
+            for (int c = 0; c < n_voigt; ++c)
+              properties[Layout::stress + c] = points.stress[c][i];
+            properties[Layout::material]       = points.material[i];
+            properties[Layout::material_field] = points.material_field[i];
 
             dealii::Point<dim> location;
             for (int d = 0; d < dim; ++d)
@@ -406,4 +423,6 @@ namespace mpm
   template struct PropertyLayout<3>;
   template class MaterialPoints<2>;
   template class MaterialPoints<3>;
+  template std::vector<GeneratedBody<2>> generate_bodies<2>(const Parameters &);
+  template std::vector<GeneratedBody<3>> generate_bodies<3>(const Parameters &);
 } // namespace mpm

@@ -72,16 +72,18 @@ namespace mpm
     const auto wall_start = std::chrono::steady_clock::now();
 
     // Set-up: grid, material points, engine, output. The CUDA context is created on a
-    // thread of its own meanwhile (0.3-0.5 s on the GPU host).
+    // thread of its own meanwhile (0.3-0.5 s on the GPU host), and the bodies' points on
+    // another (they need the lattice only); they go into the handler once the grid exists.
     std::future<void> cuda_ready;
     if (parameters.backend == "cuda")
       cuda_ready = start_cuda_initialisation();
+    auto bodies = std::async(std::launch::async, [this]() { return generate_bodies<dim>(parameters); });
     timer.enter_subsection("setup: grid");
     BackgroundGrid<dim> grid(parameters, communicator);
     timer.leave_subsection();
     timer.enter_subsection("setup: material points");
     MaterialPoints<dim> points(grid, parameters);
-    points.generate(parameters);
+    points.insert(bodies.get());
     timer.leave_subsection();
     timer.enter_subsection("setup: engine and output");
     const long n_points_initial = static_cast<long>(points.handler.n_global_particles());

@@ -212,13 +212,11 @@ namespace mpm
         for (size_t k = 0; k < staging.size(); ++k)
           to[host_node[k]] = staging[k];
       };
+      // Mass and velocity only: the nodal fields that the output writes (a quarter of the
+      // bytes of all four arrays; after the step, force[] holds G2P's blended vector).
       download(g.mass, dg.mass);
       for (int d = 0; d < dim; ++d)
-        {
-          download(g.momentum[d], dg.momentum[d]);
-          download(g.force[d], dg.force[d]);
-          download(g.velocity[d], dg.velocity[d]);
-        }
+        download(g.velocity[d], dg.velocity[d]);
     }
 
     template <int dim>

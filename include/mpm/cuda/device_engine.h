@@ -66,8 +66,8 @@ namespace mpm
       // The device re-sorts its points by stencil every `steps` steps (0: never), so
       // that the nodal sums of a warp are reduced before the atomics; default 20.
       void set_sort_interval(int steps);
-      // Device -> host: nodal mass, momentum, force and velocity into the host grid's
-      // arrays (same numbering and length as at construction).
+      // Device -> host: nodal mass and velocity (what the output writes) into the host
+      // grid's arrays (same numbering and length as at construction).
       void download_nodal(const GridView<dim, double> &host_grid) const;
 
       // One step on the device; only the reduction (max speed, power of gravity) comes back.

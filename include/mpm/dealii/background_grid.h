@@ -10,6 +10,7 @@
 // set; the step loop keeps every point within that distance (doc/performance.md, MPI).
 #pragma once
 
+#include <mpm/core/host_storage.h>
 #include <mpm/core/views.h>
 #include <mpm/dealii/parameters.h>
 
@@ -26,6 +27,11 @@
 
 namespace mpm
 {
+  // The lattice of the background grid from the prm alone: origin, cell size and cells
+  // per direction, no nodal arrays (point generation needs no more, before the grid exists).
+  template <int dim>
+  HostGrid<dim, double> lattice_geometry(const Parameters &parameters);
+
   template <int dim>
   class BackgroundGrid
   {

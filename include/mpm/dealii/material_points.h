@@ -66,6 +66,19 @@ namespace mpm
     void properties(int i, double *values) const;
   };
 
+  // The points of one body with their initial stress and material field value.
+  template <int dim>
+  struct GeneratedBody
+  {
+    HostPoints<dim, double> points;
+  };
+
+  // Every body's points from the prm on the lattice of the background grid
+  // (lattice_geometry). It needs no deal.II grid, so the simulator runs it on a thread
+  // while the grid is built.
+  template <int dim>
+  std::vector<GeneratedBody<dim>> generate_bodies(const Parameters &parameters);
+
   template <int dim>
   class MaterialPoints
   {
@@ -75,7 +88,9 @@ namespace mpm
     MaterialPoints(BackgroundGrid<dim> &grid, const Parameters &parameters);
 
     // Fills the handler with the points of every body inside this rank's cells.
-    void generate(const Parameters &parameters);
+    void generate(const Parameters &parameters) { insert(generate_bodies<dim>(parameters)); }
+    // The same from bodies generated beforehand.
+    void insert(const std::vector<GeneratedBody<dim>> &bodies);
 
     // Handler -> core arrays (after generation and after every re-sort). If home_cells
     // is given, it receives the lattice index of each point's (locally owned) cell; if
