@@ -105,6 +105,18 @@ namespace mpm
       ExchangeAdapter              exchange;
       // Host node number of each device node, where the device renumbered them (empty: same numbering).
       std::vector<int>             host_node_of_device_node;
+      // The last step's pressure averaging is left to the next step's P2G (explicit_step);
+      // download_points finishes it first.
+      bool                         averaging_pending = false;
+
+      // The device grid's view, with the averaging's cell arrays where they exist.
+      GridView<dim, double> view()
+      {
+        GridView<dim, double> g = grid.view();
+        if (cell_volume.size() > 0)
+          set_cell_arrays(g, cell_volume.data(), cell_pressure_volume.data(), HasCellArrays<GridView<dim, double>>());
+        return g;
+      }
     };
 
     template <int dim>
@@ -175,11 +187,17 @@ namespace mpm
       impl->points.upload(p);
       impl->order.reset(impl->backend, impl->points.size());
       impl->steps_since_upload = 0;
+      impl->averaging_pending  = false; // the host's stresses are final
     }
 
     template <int dim>
     void DeviceEngine<dim>::download_points(HostPoints<dim, double> &p) const
     {
+      if (impl->averaging_pending)
+        {
+          stages::finish_pressure_averaging(impl->backend, impl->view(), impl->points.view());
+          impl->averaging_pending = false;
+        }
       impl->backend.synchronize();
       impl->order.download_in_reference_order(impl->backend, impl->points, p);
     }
@@ -240,14 +258,14 @@ namespace mpm
               impl->cell_volume.resize(impl->n_lattice_cells);
               impl->cell_pressure_volume.resize(impl->n_lattice_cells);
             }
-          set_cell_arrays(g, impl->cell_volume.data(), impl->cell_pressure_volume.data(),
-                          HasCellArrays<GridView<dim, double>>());
+          g = impl->view();
         }
       const long step_index = impl->steps_since_upload - 1;
       const bool timed      = impl->timed_from >= 0 && step_index >= impl->timed_from && impl->n_timed_steps < 5;
       impl->backend.enable_kernel_timing(timed);
       const StepReduction<double> r = explicit_step<dim>(impl->backend, impl->shape, g, impl->points.view(),
-                                                         impl->materials.data(), s, dt, impl->exchange);
+                                                         impl->materials.data(), s, dt, impl->exchange,
+                                                         &impl->averaging_pending);
       if (timed)
         {
           const std::vector<float> times = impl->backend.kernel_times_ms();

@@ -5,7 +5,10 @@
 //  - the deviatoric stress of every point is untouched;
 //  - the total pressure-volume sum_p V_p p_p is conserved, per cell and overall;
 //  - a cell holding one point, removed points and a second averaging change nothing;
-//  - the full step with averaging on leaves equal pressures per cell (MUSL, USL, USF).
+//  - the full step with averaging on leaves equal pressures per cell (MUSL, USL, USF);
+//  - the deferred averaging (explicit_step's averaging_pending: applied by the next
+//    step's P2G or by finish_pressure_averaging) gives the same points as the one done
+//    at the end of each step, to the last bit (the same operations on the same values).
 #include "check.h"
 #include "scene_helpers.h"
 
@@ -167,6 +170,52 @@ namespace
                 int(scheme), worst, scale);
     check_below(worst, 1e-12 * scale, "one pressure per cell after a step with averaging");
   }
+  // Deferred against immediate averaging, 5 steps with a finish at the end.
+  template <int dim>
+  void test_deferred(const UpdateScheme scheme)
+  {
+    std::mt19937          rng(11);
+    HostGrid<dim, double> g_now, g_later;
+    const double          lower[3] = {0, 0, 0};
+    const int             cells[3] = {8, 8, 8};
+    g_now.make_dense(lower, 0.125, cells);
+    g_later.make_dense(lower, 0.125, cells);
+    HostPoints<dim, double> now;
+    mpm_test::random_points<dim>(now, g_now, 400, rng);
+    HostPoints<dim, double> later = now;
+    auto s                        = mpm_test::quiet_settings<dim>(scheme);
+    s.pressure_averaging          = true;
+    std::vector<MaterialParameters<double>> materials = {mpm_test::elastic(1e4, 0.3)};
+    CpuBackend                              backend;
+    bool                                    pending = false;
+    for (int step = 0; step < 5; ++step)
+      {
+        explicit_step<dim, GimpShape>(backend, g_now.view(), now.view(), materials.data(), s, 1e-4);
+        explicit_step<dim, GimpShape>(backend, g_later.view(), later.view(), materials.data(), s, 1e-4,
+                                      NoGridExchange(), &pending);
+      }
+    check(pending == (scheme != UpdateScheme::usf), "MUSL and USL leave the averaging pending, USF does not");
+    double before = 0;
+    for (int i = 0; i < now.size(); ++i)
+      for (int c = 0; c < n_voigt; ++c)
+        before = std::max(before, std::fabs(now.stress[c][i] - later.stress[c][i]));
+    if (pending)
+      stages::finish_pressure_averaging(backend, g_later.view(), later.view());
+    double after = 0;
+    for (int i = 0; i < now.size(); ++i)
+      {
+        for (int c = 0; c < n_voigt; ++c)
+          after = std::max(after, std::fabs(now.stress[c][i] - later.stress[c][i]));
+        for (int d = 0; d < dim; ++d)
+          after = std::max({after, std::fabs(now.position[d][i] - later.position[d][i]),
+                            std::fabs(now.velocity[d][i] - later.velocity[d][i])});
+      }
+    std::printf("%dD deferred averaging (scheme %d): stress difference %.2e before the finish, %.2e after\n", dim,
+                int(scheme), before, after);
+    if (pending)
+      check(before > 0, "the deferred averaging is still pending before the finish");
+    check(after == 0, "deferred averaging = averaging at the end of each step, bit for bit");
+  }
 } // namespace
 
 int main()
@@ -177,6 +226,8 @@ int main()
     {
       test_in_step<2>(scheme);
       test_in_step<3>(scheme);
+      test_deferred<2>(scheme);
+      test_deferred<3>(scheme);
     }
   return mpm_test::finish("test_pressure_averaging");
 }

@@ -86,6 +86,16 @@ namespace mpm
     : std::bool_constant<Backend::colours_scatter>
   {};
 
+  // Backends whose add_to_node is atomic, so that a gather loop may also scatter into
+  // cells (CudaBackend); the others scatter only inside scatter_points.
+  template <typename Backend, typename = void>
+  struct atomic_scatter : std::false_type
+  {};
+  template <typename Backend>
+  struct atomic_scatter<Backend, std::void_t<decltype(Backend::atomic_scatter)>>
+    : std::bool_constant<Backend::atomic_scatter>
+  {};
+
   // Host backends that lend per-point scratch memory kept between steps
   // (CpuBackend::point_scratch(n, bytes per point)).
   template <typename Backend, typename = void>
@@ -163,6 +173,18 @@ namespace mpm
       });
     }
 
+    // The pressure averaging's shift of the normal stresses s_xx, s_yy, s_zz of a point at
+    // x: its cell's volume-weighted mean stress (summed by scatter_cell_pressure) minus
+    // the point's own (plane strain: sigma_zz included).
+    template <int dim, typename Real>
+    MPM_HOST_DEVICE inline Real cell_pressure_shift(const GridView<dim, Real> &g, const Real x[dim], const Real s_xx,
+                                                    const Real s_yy, const Real s_zz)
+    {
+      const Real mean = (s_xx + s_yy + s_zz) / Real(3);
+      const int  c    = g.lattice_cell(x);
+      return g.cell_pressure_volume[c] / g.cell_volume[c] - mean;
+    }
+
     // P2G: nodal mass and momentum, and/or internal (-V sigma . grad N) and gravity forces.
     template <int dim, typename Shape, typename Real, typename Backend>
     void particles_to_grid(Backend                          &backend,
@@ -171,7 +193,8 @@ namespace mpm
                            const StepSettings<dim, Real>    &s,
                            const bool                        mass_and_momentum,
                            const bool                        forces,
-                           void                             *stencils = nullptr)
+                           void                             *stencils = nullptr,
+                           const bool                        apply_averaging = false)
     {
       backend.scatter_points(p.n_points, [=] MPM_HOST_DEVICE(const int i) {
         if (p.material[i] < 0)
@@ -187,6 +210,15 @@ namespace mpm
         SymTensor<Real> sigma;
         for (int c = 0; c < n_voigt; ++c)
           sigma[c] = p.stress[c][i];
+        if (apply_averaging) // the last step's, left pending (explicit_step)
+          {
+            const Real shift = cell_pressure_shift(g, x, sigma[0], sigma[1], sigma[2]);
+            for (int k = 0; k < 3; ++k)
+              {
+                sigma[k] += shift;
+                p.stress[k][i] = sigma[k];
+              }
+          }
 
         // Nodal arrays in the order of the values: mass, momentum, force. Each value is
         // linear in N and grad N (stencil_contribution.h): mass m N, momentum m v N, force
@@ -253,9 +285,19 @@ namespace mpm
     // so that G2P gathers one nodal vector instead of two (updated_point_velocity).
     template <int dim, typename Real, typename Backend>
     void update_grid(Backend &backend, const GridView<dim, Real> &g, const StepSettings<dim, Real> &s,
-                     const Real dt, const bool zero_momentum = false)
+                     const Real dt, const bool zero_momentum = false, const bool zero_cells = false)
     {
-      backend.for_each_node(g.n_nodes, [=] MPM_HOST_DEVICE(const int n) {
+      // zero_cells: also the pressure averaging's cell sums, which this step's P2G has
+      // just applied (explicit_step's deferred averaging), in the same launch.
+      const int n_cells = zero_cells ? g.n_lattice_cells() : 0;
+      backend.for_each_node(g.n_nodes > n_cells ? g.n_nodes : n_cells, [=] MPM_HOST_DEVICE(const int n) {
+        if (n < n_cells)
+          {
+            g.cell_volume[n]          = Real(0);
+            g.cell_pressure_volume[n] = Real(0);
+          }
+        if (n >= g.n_nodes)
+          return;
         const Real m = g.mass[n];
         for (int d = 0; d < dim; ++d)
           {
@@ -384,6 +426,43 @@ namespace mpm
       });
     }
 
+    // Lattice cell of point i and its mean stress tr(sigma)/3 (plane strain: sigma_zz
+    // included), for both passes of the pressure averaging.
+    template <int dim, typename Real>
+    MPM_HOST_DEVICE inline int cell_and_mean_stress(const GridView<dim, Real> &g, const PointsView<dim, Real> &p,
+                                                    const int i, Real &mean)
+    {
+      Real x[dim];
+      for (int d = 0; d < dim; ++d)
+        x[d] = p.position[d][i];
+      mean = (p.stress[0][i] + p.stress[1][i] + p.stress[2][i]) / Real(3);
+      return g.lattice_cell(x);
+    }
+
+    // The first pass of the averaging for point i (not removed): V_p and V_p p_p into its
+    // cell's sums.
+    template <typename Backend, int dim, typename Real>
+    MPM_HOST_DEVICE inline void add_cell_pressure(const GridView<dim, Real> &g, const PointsView<dim, Real> &p,
+                                                  const int i)
+    {
+      Real        mean;
+      const int   c          = cell_and_mean_stress(g, p, i, mean);
+      const Real  V          = p.volume[i];
+      Real *const targets[2] = {g.cell_volume, g.cell_pressure_volume};
+      const Real  values[2]  = {V, V * mean};
+      Backend::template add_to_node<2>(targets, c, values);
+    }
+
+    // The same from a per-point loop other than scatter_points: only where add_to_node is
+    // atomic (grid_to_particle_kinematics refuses the others before it starts).
+    template <typename Backend, int dim, typename Real>
+    MPM_HOST_DEVICE inline void add_cell_pressure_atomically(const GridView<dim, Real> &g,
+                                                             const PointsView<dim, Real> &p, const int i)
+    {
+      if constexpr (atomic_scatter<Backend>::value)
+        add_cell_pressure<Backend>(g, p, i);
+    }
+
     // G2P kinematics from the nodal velocity field, then per point: position,
     // strain and spin increments, volume and particle domain, constitutive update.
     // A point whose centre leaves the grid is marked removed (material = -1).
@@ -395,8 +474,13 @@ namespace mpm
                                      const MaterialParameters<Real> *materials,
                                      const StepSettings<dim, Real> &s, const Real dt,
                                      const bool move_points, const bool deform_points,
-                                     const void *stencils = nullptr)
+                                     const void *stencils = nullptr, const bool scatter_pressure = false)
     {
+      // scatter_pressure (atomic backends only): the first pass of the pressure averaging
+      // too, at the end of each point's update (one pass over the points less).
+      if constexpr (!atomic_scatter<Backend>::value)
+        if (scatter_pressure)
+          throw std::invalid_argument("grid_to_particle_kinematics: this backend scatters only in scatter_points");
       backend.gather_points(p.n_points, [=] MPM_HOST_DEVICE(const int i) {
         if (p.material[i] < 0)
           return;
@@ -499,6 +583,8 @@ namespace mpm
 
         if (leaves_grid)
           p.material[i] = -1;
+        else if (scatter_pressure)
+          add_cell_pressure_atomically<Backend>(g, p, i);
       });
     }
 
@@ -513,19 +599,6 @@ namespace mpm
     template <typename Exchange, typename Real>
     void sum_cells(const Exchange &, Real *const *, const int, long)
     {}
-
-    // Lattice cell of point i and its mean stress tr(sigma)/3 (plane strain: sigma_zz
-    // included), for both passes of the pressure averaging.
-    template <int dim, typename Real>
-    MPM_HOST_DEVICE inline int cell_and_mean_stress(const GridView<dim, Real> &g, const PointsView<dim, Real> &p,
-                                                    const int i, Real &mean)
-    {
-      Real x[dim];
-      for (int d = 0; d < dim; ++d)
-        x[d] = p.position[d][i];
-      mean = (p.stress[0][i] + p.stress[1][i] + p.stress[2][i]) / Real(3);
-      return g.lattice_cell(x);
-    }
 
     // Cell pressure averaging (against volumetric locking, as in ep2-3De): every point
     // of a lattice cell gets the volume-weighted mean pressure of the cell,
@@ -543,14 +616,8 @@ namespace mpm
       if (g.cell_volume == nullptr || g.cell_pressure_volume == nullptr)
         throw std::invalid_argument("pressure averaging needs GridView::cell_volume and cell_pressure_volume");
       backend.scatter_points(p.n_points, [=] MPM_HOST_DEVICE(const int i) {
-        if (p.material[i] < 0)
-          return;
-        Real       mean;
-        const int  c = cell_and_mean_stress(g, p, i, mean);
-        const Real V = p.volume[i];
-        Real *const targets[2] = {g.cell_volume, g.cell_pressure_volume};
-        const Real  values[2]  = {V, V * mean};
-        Backend::template add_to_node<2>(targets, c, values);
+        if (p.material[i] >= 0)
+          add_cell_pressure<Backend>(g, p, i);
       });
       // MPI: a cell near a partition boundary holds points of two ranks (a point that has
       // not migrated yet sits less than a cell outside its home cell): sum over ranks.
@@ -563,11 +630,23 @@ namespace mpm
     MPM_HOST_DEVICE inline void apply_cell_pressure(const GridView<dim, Real> &g, const PointsView<dim, Real> &p,
                                                     const int i)
     {
-      Real       mean;
-      const int  c     = cell_and_mean_stress(g, p, i, mean);
-      const Real shift = g.cell_pressure_volume[c] / g.cell_volume[c] - mean;
+      Real x[dim];
+      for (int d = 0; d < dim; ++d)
+        x[d] = p.position[d][i];
+      const Real shift = cell_pressure_shift(g, x, p.stress[0][i], p.stress[1][i], p.stress[2][i]);
       for (int k = 0; k < 3; ++k)
         p.stress[k][i] += shift;
+    }
+
+    // Both passes' last part: every point's pending averaging (explicit_step with a
+    // deferred averaging), before its stresses are read outside the step.
+    template <int dim, typename Real, typename Backend>
+    void finish_pressure_averaging(Backend &backend, const GridView<dim, Real> &g, const PointsView<dim, Real> &p)
+    {
+      backend.gather_points(p.n_points, [=] MPM_HOST_DEVICE(const int i) {
+        if (p.material[i] >= 0)
+          apply_cell_pressure(g, p, i);
+      });
     }
 
     // Both passes, cell sums zeroed first (USF, whose averaging is not the step's last pass).
@@ -631,7 +710,7 @@ namespace mpm
                                     const PointsView<dim, Real> &p,
                                     const MaterialParameters<Real> *materials,
                                     const StepSettings<dim, Real> &s, const Real dt,
-                                    const Exchange &exchange = Exchange())
+                                    const Exchange &exchange = Exchange(), bool *averaging_pending = nullptr)
   {
     using namespace stages;
     Real *mass_and_momentum[dim + 1], *momentum[dim], *forces[dim];
@@ -642,6 +721,28 @@ namespace mpm
         forces[d]                              = g.force[d];
       }
 
+    // The last step's averaging, deferred to this step's P2G (MUSL, USL).
+    const bool apply_pending = averaging_pending != nullptr && *averaging_pending && s.pressure_averaging &&
+                               s.scheme != UpdateScheme::usf;
+    if (averaging_pending != nullptr && *averaging_pending && !apply_pending)
+      throw std::invalid_argument("explicit_step: a deferred pressure averaging is pending but this step does not "
+                                  "apply it (finish_pressure_averaging first)");
+    // MUSL and USL: the averaging's first pass after the kinematics, or in it where the
+    // backend's scatter is atomic (one pass over the points less); its second pass below
+    // or, deferred, in the next P2G.
+    const bool scatter_in_kinematics = s.pressure_averaging && atomic_scatter<Backend>::value;
+    auto       scatter_averaged_pressure = [&]() {
+      if (!s.pressure_averaging)
+        return;
+      if (scatter_in_kinematics)
+        {
+          Real *cell_sums[2] = {g.cell_volume, g.cell_pressure_volume};
+          sum_cells(exchange, cell_sums, 2, 0);
+          return;
+        }
+      group_for_scatter<dim, Shape>(backend, g, p); // the points have moved
+      scatter_cell_pressure(backend, g, p, exchange);
+    };
     group_for_scatter<dim, Shape>(backend, g, p);
     switch (s.scheme)
       {
@@ -654,36 +755,30 @@ namespace mpm
             if constexpr (has_point_scratch<Backend>::value)
               stencils = backend.point_scratch(p.n_points, sizeof(HostStencil<dim, Shape, Real>));
 #endif
-            reset_grid(backend, g, true, s.pressure_averaging);
-            particles_to_grid<dim, Shape>(backend, g, p, s, true, true, stencils);
+            reset_grid(backend, g, true, s.pressure_averaging && !apply_pending);
+            particles_to_grid<dim, Shape>(backend, g, p, s, true, true, stencils, apply_pending);
             exchange.sum_nodal(mass_and_momentum, dim + 1);
             exchange.sum_nodal(forces, dim);
-            update_grid(backend, g, s, dt, true);
+            update_grid(backend, g, s, dt, true, apply_pending);
             grid_to_particle_velocity_and_remap<dim, Shape>(backend, g, p, s, stencils);
             exchange.sum_nodal(momentum, dim);
             velocity_from_momentum(backend, g, s.mass_tolerance);
-            grid_to_particle_kinematics<dim, Shape>(backend, g, p, materials, s, dt, true, true, stencils);
+            grid_to_particle_kinematics<dim, Shape>(backend, g, p, materials, s, dt, true, true, stencils,
+                                                    scatter_in_kinematics);
           }
-          if (s.pressure_averaging)
-            {
-              group_for_scatter<dim, Shape>(backend, g, p); // the points have moved
-              scatter_cell_pressure(backend, g, p, exchange); // gathered back by reduce_step
-            }
+          scatter_averaged_pressure();
           break;
 
         case UpdateScheme::usl:
-          reset_grid(backend, g, true, s.pressure_averaging);
-          particles_to_grid<dim, Shape>(backend, g, p, s, true, true);
+          reset_grid(backend, g, true, s.pressure_averaging && !apply_pending);
+          particles_to_grid<dim, Shape>(backend, g, p, s, true, true, nullptr, apply_pending);
           exchange.sum_nodal(mass_and_momentum, dim + 1);
           exchange.sum_nodal(forces, dim);
-          update_grid(backend, g, s, dt);
+          update_grid(backend, g, s, dt, false, apply_pending);
           grid_to_particle_velocity<dim, Shape>(backend, g, p, s);
-          grid_to_particle_kinematics<dim, Shape>(backend, g, p, materials, s, dt, true, true);
-          if (s.pressure_averaging)
-            {
-              group_for_scatter<dim, Shape>(backend, g, p); // the points have moved
-              scatter_cell_pressure(backend, g, p, exchange); // gathered back by reduce_step
-            }
+          grid_to_particle_kinematics<dim, Shape>(backend, g, p, materials, s, dt, true, true, nullptr,
+                                                  scatter_in_kinematics);
+          scatter_averaged_pressure();
           break;
 
         case UpdateScheme::usf:
@@ -703,7 +798,17 @@ namespace mpm
       }
     if constexpr (colours_scatter<Backend>::value)
       backend.ungroup(); // the points have moved: the next group_for_scatter checks the grouping again
-    return reduce_step(backend, g, p, s, s.pressure_averaging && s.scheme != UpdateScheme::usf);
+    // MUSL and USL average at the end of the step. Deferred (averaging_pending given), the
+    // points keep their stresses before the averaging and the grid its cell sums: the next
+    // step's P2G applies it as it reads the stresses (one pass over the points less), and
+    // finish_pressure_averaging() does where the points are read before that.
+    const bool averaged_last = s.pressure_averaging && s.scheme != UpdateScheme::usf;
+    if (averaging_pending != nullptr)
+      {
+        *averaging_pending = averaged_last;
+        return reduce_step(backend, g, p, s, false);
+      }
+    return reduce_step(backend, g, p, s, averaged_last);
   }
 
   // Dispatch on the shape function chosen at run time.
@@ -712,10 +817,10 @@ namespace mpm
                                     const GridView<dim, Real> &g, const PointsView<dim, Real> &p,
                                     const MaterialParameters<Real> *materials,
                                     const StepSettings<dim, Real> &s, const Real dt,
-                                    const Exchange &exchange = Exchange())
+                                    const Exchange &exchange = Exchange(), bool *averaging_pending = nullptr)
   {
     if (shape == ShapeFunction::gimp)
-      return explicit_step<dim, GimpShape>(backend, g, p, materials, s, dt, exchange);
-    return explicit_step<dim, LinearShape>(backend, g, p, materials, s, dt, exchange);
+      return explicit_step<dim, GimpShape>(backend, g, p, materials, s, dt, exchange, averaging_pending);
+    return explicit_step<dim, LinearShape>(backend, g, p, materials, s, dt, exchange, averaging_pending);
   }
 } // namespace mpm

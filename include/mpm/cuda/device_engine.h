@@ -61,7 +61,9 @@ namespace mpm
       // Host -> device: the whole point set (its size may have changed).
       void upload_points(const HostPoints<dim, double> &points);
       // Device -> host: every point array (points that left the grid have material < 0),
-      // in the order of the last upload, whatever order the device keeps them in.
+      // in the order of the last upload, whatever order the device keeps them in. The
+      // last step's pressure averaging, which the engine leaves to the next step's P2G,
+      // is applied first.
       void download_points(HostPoints<dim, double> &points) const;
       // The device re-sorts its points by stencil every `steps` steps (0: never), so
       // that the nodal sums of a warp are reduced before the atomics; default 20.

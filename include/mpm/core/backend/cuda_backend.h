@@ -156,6 +156,8 @@ namespace mpm
   {
   public:
     static constexpr const char *name = "cuda";
+    // add_to_node is atomic: any per-point loop may scatter into cells (step.h).
+    static constexpr bool atomic_scatter = true;
 
     // Threads per block of the item loops (lowered per kernel to what its registers allow);
     // the reduction uses reduce_threads. 128 measured 9% faster than 256 on P1 (H100,
