@@ -37,7 +37,11 @@ if command -v compute-sanitizer >/dev/null; then
   # small scene: P1 with 2 cells across (10,024 points), 20 steps
   compute-sanitizer --tool memcheck --leak-check full "$B" --sizes 2 --steps 20 >"$OUT/memcheck.log" 2>&1 || status=1
   compute-sanitizer --tool racecheck "$B" --sizes 2 --steps 5 >"$OUT/racecheck.log" 2>&1 || status=1
+  # the device engine (dealii-mpm's Backend = cuda) with pressure averaging: its scatter in
+  # the kinematics and its gather deferred to the next P2G
+  compute-sanitizer --tool memcheck "$BUILD/tests/gpu/test_gpu_device_engine" >"$OUT/memcheck_engine.log" 2>&1 || status=1
   echo "memcheck:  $(grep -E 'ERROR SUMMARY|LEAK SUMMARY' "$OUT/memcheck.log" | tr '\n' ' ')"
+  echo "memcheck (device engine): $(grep -E 'ERROR SUMMARY' "$OUT/memcheck_engine.log" | tr '\n' ' ')"
   echo "racecheck: $(grep -E 'RACECHECK SUMMARY|ERROR SUMMARY' "$OUT/racecheck.log" | tr '\n' ' ')"
 else
   echo "compute-sanitizer: not found"
