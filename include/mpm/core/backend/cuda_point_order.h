@@ -27,12 +27,26 @@ namespace mpm
 {
   namespace cuda_detail
   {
+    // Up to group_size arrays gathered through one permutation in one launch (the re-sort
+    // permutes about 40 point arrays: one launch each cost more than the copies).
+    constexpr int group_size = 8;
     template <typename T>
-    __global__ void gather_kernel(const int n, const int *permutation, const T *in, T *out)
+    struct ArrayGroup
+    {
+      const T *from[group_size];
+      T       *to[group_size];
+      int      count;
+    };
+    template <typename T>
+    __global__ void gather_group_kernel(const int n, const int *permutation, const ArrayGroup<T> group)
     {
       const int i = static_cast<int>(blockIdx.x * blockDim.x + threadIdx.x);
-      if (i < n)
-        out[i] = in[permutation[i]];
+      if (i >= n)
+        return;
+      const int source = permutation[i];
+      for (int k = 0; k < group_size; ++k)
+        if (k < group.count)
+          group.to[k][i] = group.from[k][source];
     }
 
     template <typename T>
@@ -111,8 +125,11 @@ namespace mpm
                                                      identity.data(), permutation.data(), n, 0, end_bit,
                                                      backend.get_stream()));
 
-      for_each_point_array<dim>(points, points, [&](auto &array, auto &) { permute(backend, array); });
-      permute(backend, original);
+      std::vector<DeviceArray<Real> *> reals;
+      std::vector<DeviceArray<int> *>  ints{&original};
+      for_each_point_array<dim>(points, points, [&](auto &array, auto &) { collect(array, reals, ints); });
+      permute(backend, reals, real_group_scratch);
+      permute(backend, ints, int_group_scratch);
     }
 
     // Every point array copied to the host in the reference order: put back in that order
@@ -143,18 +160,52 @@ namespace mpm
     DeviceArray<int>  keys, sorted_keys, identity, permutation, original, int_scratch;
     DeviceArray<Real> real_scratch;
     DeviceArray<char> temp;
+    // One scratch array per slot of a group: each permuted array swaps with its slot's.
+    std::vector<DeviceArray<Real>> real_group_scratch = std::vector<DeviceArray<Real>>(cuda_detail::group_size);
+    std::vector<DeviceArray<int>>  int_group_scratch  = std::vector<DeviceArray<int>>(cuda_detail::group_size);
 
-    template <typename T>
-    void permute(CudaBackend &backend, DeviceArray<T> &array)
+    static void collect(DeviceArray<Real> &array, std::vector<DeviceArray<Real> *> &reals,
+                        std::vector<DeviceArray<int> *> &)
     {
-      DeviceArray<T> &scratch = scratch_for(array);
-      scratch.resize(array.size());
-      const int n       = static_cast<int>(array.size());
+      reals.push_back(&array);
+    }
+    static void collect(DeviceArray<int> &array, std::vector<DeviceArray<Real> *> &,
+                        std::vector<DeviceArray<int> *> &ints)
+    {
+      ints.push_back(&array);
+    }
+
+    // Every array gathered through the permutation, group_size arrays per launch.
+    template <typename T>
+    void permute(CudaBackend &backend, const std::vector<DeviceArray<T> *> &arrays,
+                 std::vector<DeviceArray<T>> &scratch)
+    {
+      const int n       = static_cast<int>(permutation.size());
       const int threads = 256;
-      cuda_detail::gather_kernel<T><<<(n + threads - 1) / threads, threads, 0, backend.get_stream()>>>(
-        n, permutation.data(), array.data(), scratch.data());
-      MPM_CUDA_CHECK_LAUNCH();
-      array.swap(scratch);
+      for (std::size_t first = 0; first < arrays.size(); first += cuda_detail::group_size)
+        {
+          cuda_detail::ArrayGroup<T> group{};
+          std::vector<int>           slots;
+          for (std::size_t a = first; a < arrays.size() && a < first + cuda_detail::group_size; ++a)
+            {
+              if (arrays[a]->size() == 0)
+                continue; // an optional array that these points leave out
+              if (static_cast<int>(arrays[a]->size()) != n)
+                throw std::logic_error("PointOrder::sort: a point array has another length than the points");
+              const int slot = group.count++;
+              scratch[slot].resize(n);
+              group.from[slot] = arrays[a]->data();
+              group.to[slot]   = scratch[slot].data();
+              slots.push_back(static_cast<int>(a));
+            }
+          if (group.count == 0)
+            continue;
+          cuda_detail::gather_group_kernel<T><<<(n + threads - 1) / threads, threads, 0, backend.get_stream()>>>(
+            n, permutation.data(), group);
+          MPM_CUDA_CHECK_LAUNCH();
+          for (int slot = 0; slot < group.count; ++slot)
+            arrays[slots[slot]]->swap(scratch[slot]);
+        }
     }
 
     DeviceArray<Real> &scratch_for(const DeviceArray<Real> &) { return real_scratch; }
