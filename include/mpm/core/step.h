@@ -147,21 +147,38 @@ namespace mpm
         }
     }
 
+    // Number of the pressure averaging's cell sums a node loop zeroes along the way (0
+    // unless cells_too), checking that the grid has them.
+    template <int dim, typename Real>
+    int cell_sums_to_zero(const GridView<dim, Real> &g, const bool cells_too)
+    {
+      if (cells_too && (g.cell_volume == nullptr || g.cell_pressure_volume == nullptr))
+        throw std::invalid_argument("pressure averaging needs GridView::cell_volume and cell_pressure_volume");
+      return cells_too ? g.n_lattice_cells() : 0;
+    }
+
+    // Item n of a node loop over max(n_nodes, n_cells) items: zeroes cell n's sums where
+    // n < n_cells; returns whether n is a node.
+    template <int dim, typename Real>
+    MPM_HOST_DEVICE inline bool zero_cell_sums_then_is_node(const GridView<dim, Real> &g, const int n,
+                                                             const int n_cells)
+    {
+      if (n < n_cells)
+        {
+          g.cell_volume[n]          = Real(0);
+          g.cell_pressure_volume[n] = Real(0);
+        }
+      return n < g.n_nodes;
+    }
+
     // Nodal sums to zero before a P2G pass; with cells_too also the pressure averaging's
     // cell sums, in the same pass (one launch less on the device).
     template <int dim, typename Real, typename Backend>
     void reset_grid(Backend &backend, const GridView<dim, Real> &g, const bool mass_too, const bool cells_too = false)
     {
-      if (cells_too && (g.cell_volume == nullptr || g.cell_pressure_volume == nullptr))
-        throw std::invalid_argument("pressure averaging needs GridView::cell_volume and cell_pressure_volume");
-      const int n_cells = cells_too ? g.n_lattice_cells() : 0;
+      const int n_cells = cell_sums_to_zero(g, cells_too);
       backend.for_each_node(g.n_nodes > n_cells ? g.n_nodes : n_cells, [=] MPM_HOST_DEVICE(const int n) {
-        if (n < n_cells)
-          {
-            g.cell_volume[n]          = Real(0);
-            g.cell_pressure_volume[n] = Real(0);
-          }
-        if (n >= g.n_nodes)
+        if (!zero_cell_sums_then_is_node(g, n, n_cells))
           return;
         if (mass_too)
           g.mass[n] = Real(0);
@@ -176,11 +193,16 @@ namespace mpm
     // The pressure averaging's shift of the normal stresses s_xx, s_yy, s_zz of a point at
     // x: its cell's volume-weighted mean stress (summed by scatter_cell_pressure) minus
     // the point's own (plane strain: sigma_zz included).
+    template <typename Real>
+    MPM_HOST_DEVICE inline Real mean_normal_stress(const Real s_xx, const Real s_yy, const Real s_zz)
+    {
+      return (s_xx + s_yy + s_zz) / Real(3);
+    }
     template <int dim, typename Real>
     MPM_HOST_DEVICE inline Real cell_pressure_shift(const GridView<dim, Real> &g, const Real x[dim], const Real s_xx,
                                                     const Real s_yy, const Real s_zz)
     {
-      const Real mean = (s_xx + s_yy + s_zz) / Real(3);
+      const Real mean = mean_normal_stress(s_xx, s_yy, s_zz);
       const int  c    = g.lattice_cell(x);
       return g.cell_pressure_volume[c] / g.cell_volume[c] - mean;
     }
@@ -289,14 +311,9 @@ namespace mpm
     {
       // zero_cells: also the pressure averaging's cell sums, which this step's P2G has
       // just applied (explicit_step's deferred averaging), in the same launch.
-      const int n_cells = zero_cells ? g.n_lattice_cells() : 0;
+      const int n_cells = cell_sums_to_zero(g, zero_cells);
       backend.for_each_node(g.n_nodes > n_cells ? g.n_nodes : n_cells, [=] MPM_HOST_DEVICE(const int n) {
-        if (n < n_cells)
-          {
-            g.cell_volume[n]          = Real(0);
-            g.cell_pressure_volume[n] = Real(0);
-          }
-        if (n >= g.n_nodes)
+        if (!zero_cell_sums_then_is_node(g, n, n_cells))
           return;
         const Real m = g.mass[n];
         for (int d = 0; d < dim; ++d)
@@ -435,7 +452,7 @@ namespace mpm
       Real x[dim];
       for (int d = 0; d < dim; ++d)
         x[d] = p.position[d][i];
-      mean = (p.stress[0][i] + p.stress[1][i] + p.stress[2][i]) / Real(3);
+      mean = mean_normal_stress(p.stress[0][i], p.stress[1][i], p.stress[2][i]);
       return g.lattice_cell(x);
     }
 
@@ -604,9 +621,9 @@ namespace mpm
     // of a lattice cell gets the volume-weighted mean pressure of the cell,
     //   p_c = sum_p V_p p_p / sum_p V_p,   sigma_p <- s_p - p_c I   (s_p deviatoric part kept),
     // with p = -tr(sigma)/3 (plane strain: sigma_zz included). Two passes through the
-    // backend: scatter V_p and V_p p_p into per-cell sums (zeroed by reset_grid with
-    // cells_too), then gather p_c back (apply_cell_pressure, run by itself or inside the
-    // step's reduction). The averaged stress is not returned to the yield surface again
+    // backend: scatter V_p and V_p p_p into per-cell sums (zeroed by reset_grid, or by
+    // update_grid after a P2G that applied a deferred averaging), then gather p_c back
+    // (apply_cell_pressure: by itself, inside the step's reduction, or in the next P2G). The averaged stress is not returned to the yield surface again
     // (ep2-3De neither). On several ranks, exchange.sum_cells sums the cells between the
     // two passes.
     template <int dim, typename Real, typename Backend, typename Exchange = NoGridExchange>
@@ -638,8 +655,9 @@ namespace mpm
         p.stress[k][i] += shift;
     }
 
-    // Both passes' last part: every point's pending averaging (explicit_step with a
-    // deferred averaging), before its stresses are read outside the step.
+    // The averaging's gather over every point: the second pass of average_cell_pressure,
+    // and a pending one (explicit_step's deferred averaging) before the stresses are read
+    // outside the step.
     template <int dim, typename Real, typename Backend>
     void finish_pressure_averaging(Backend &backend, const GridView<dim, Real> &g, const PointsView<dim, Real> &p)
     {
@@ -654,17 +672,10 @@ namespace mpm
     void average_cell_pressure(Backend &backend, const GridView<dim, Real> &g, const PointsView<dim, Real> &p,
                                const Exchange &exchange = Exchange())
     {
-      if (g.cell_volume == nullptr || g.cell_pressure_volume == nullptr)
-        throw std::invalid_argument("pressure averaging needs GridView::cell_volume and cell_pressure_volume");
-      backend.for_each_node(g.n_lattice_cells(), [=] MPM_HOST_DEVICE(const int c) {
-        g.cell_volume[c]          = Real(0);
-        g.cell_pressure_volume[c] = Real(0);
-      });
+      const int n_cells = cell_sums_to_zero(g, true);
+      backend.for_each_node(n_cells, [=] MPM_HOST_DEVICE(const int c) { zero_cell_sums_then_is_node(g, c, n_cells); });
       scatter_cell_pressure(backend, g, p, exchange);
-      backend.gather_points(p.n_points, [=] MPM_HOST_DEVICE(const int i) {
-        if (p.material[i] >= 0)
-          apply_cell_pressure(g, p, i);
-      });
+      finish_pressure_averaging(backend, g, p);
     }
 
     // The step's reductions (largest speed, power of gravity). With apply_averaging, the
