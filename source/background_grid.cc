@@ -23,6 +23,38 @@ namespace mpm
   }
 
   template <int dim>
+  HostGrid<dim, double> lattice_grid(const Parameters &parameters)
+  {
+    const HostGrid<dim, double> lattice = lattice_geometry<dim>(parameters);
+    HostGrid<dim, double>       grid;
+    grid.make_dense(lattice.origin, lattice.h, lattice.n_cells);
+    // A node on face id (x min, x max, y min, ...) takes that face's mask: no-slip fixes
+    // every component, free-slip the normal one; edges and corners combine their faces'.
+    const long n_nodes = static_cast<long>(grid.mass.size());
+    for (long l = 0; l < n_nodes; ++l)
+      {
+        long          rest = l;
+        std::uint8_t &mask = grid.fixed_components[l];
+        for (int d = 0; d < dim; ++d)
+          {
+            const long i = rest % (lattice.n_cells[d] + 1);
+            rest /= lattice.n_cells[d] + 1;
+            for (const unsigned int id : {2u * d, 2u * d + 1})
+              {
+                if ((id % 2 == 0 && i != 0) || (id % 2 == 1 && i != lattice.n_cells[d]))
+                  continue;
+                const BoundaryType type = parameters.boundary[id];
+                if (type == BoundaryType::no_slip)
+                  mask |= std::uint8_t((1u << dim) - 1);
+                else if (type == BoundaryType::free_slip)
+                  mask |= std::uint8_t(1u << d);
+              }
+          }
+      }
+    return grid;
+  }
+
+  template <int dim>
   BackgroundGrid<dim>::BackgroundGrid(const Parameters &parameters, MPI_Comm communicator)
     : communicator(communicator)
     , n_ranks(dealii::Utilities::MPI::n_mpi_processes(communicator))
@@ -282,6 +314,8 @@ namespace mpm
   template class BackgroundGrid<3>;
   template HostGrid<2, double> lattice_geometry<2>(const Parameters &);
   template HostGrid<3, double> lattice_geometry<3>(const Parameters &);
+  template HostGrid<2, double> lattice_grid<2>(const Parameters &);
+  template HostGrid<3, double> lattice_grid<3>(const Parameters &);
   template void BackgroundGrid<2>::sum_nodal(double *const *, int) const;
   template void BackgroundGrid<3>::sum_nodal(double *const *, int) const;
   template void BackgroundGrid<2>::sum_nodal(float *const *, int) const;

@@ -4,7 +4,6 @@
 #include <mpm/dealii/cuda_engine.h>
 
 #include <deal.II/base/exceptions.h>
-#include <deal.II/base/mpi.h>
 
 #ifdef MPM_CUDA_ENGINE
 #  include <mpm/cuda/device_engine.h>
@@ -21,41 +20,48 @@ namespace mpm
     class CudaEngine : public Engine<dim>
     {
     public:
-      CudaEngine(BackgroundGrid<dim> &grid, const std::vector<MaterialParameters<double>> &materials,
+      // One rank: no ghost nodes, no exchange. The MPI version will pass a NodalExchange
+      // that sums ghost contributions on the device buffers.
+      CudaEngine(HostGrid<dim, double> lattice, const std::vector<MaterialParameters<double>> &materials,
                  const ShapeFunction shape)
-        : grid(grid)
-        // One rank: no ghost nodes, no exchange. The MPI version passes a NodalExchange
-        // that sums ghost contributions on the device buffers here.
-        , device(grid.view(), materials, shape, nullptr)
+        : device(make_grid_view<dim, double>(lattice), materials, shape, nullptr)
       {}
 
       void load(const MaterialPoints<dim> &p) override
       {
         auto new_labels = std::make_shared<PointLabels<dim>>();
         p.copy_to(host, nullptr, new_labels.get());
+        load(host, std::move(new_labels));
+      }
+
+      void load(const HostPoints<dim, double> &p, std::shared_ptr<const PointLabels<dim>> new_labels) override
+      {
         labels = std::move(new_labels); // a snapshot being written keeps the old ones
-        device.upload_points(host);
+        device.upload_points(p);
       }
 
       // End of run: points come back, points that left the grid are removed, the
       // handler's new order goes back down.
       unsigned int store(MaterialPoints<dim> &p) override
       {
+        host.resize(device.n_points());
         device.download_points(host);
         const unsigned int removed = p.copy_from(host);
         load(p);
         return removed;
       }
 
-      // Output: points and nodal fields come down; the device keeps the points in the
-      // order of the last upload (DeviceEngine's contract), which is the labels' order.
+      // Output: the points come down in the order of the last upload (DeviceEngine's
+      // contract), which is the labels' order.
       void snapshot(PointSnapshot<dim> &s) override
       {
-        s.points.resize(host.size());
+        s.points.resize(device.n_points());
         device.download_points(s.points);
-        device.download_nodal(grid.view());
         s.labels = labels;
       }
+
+      // The device's lattice-ordered nodes into the grid's numbering.
+      void nodal_to(BackgroundGrid<dim> &grid) override { device.download_nodal(grid.view()); }
 
       StepReduction<double> step(const StepSettings<dim, double> &s, const double dt) override
       {
@@ -78,9 +84,8 @@ namespace mpm
       void set_sort_interval(const int steps) override { device.set_sort_interval(steps); }
 
     private:
-      BackgroundGrid<dim>      &grid;
       cuda::DeviceEngine<dim>   device;
-      HostPoints<dim, double>   host; // staging for load/store only
+      HostPoints<dim, double>   host; // staging for load/store from the handler only
       std::shared_ptr<const PointLabels<dim>> labels; // id, initial position, in the uploaded order
     };
   } // namespace
@@ -98,7 +103,7 @@ namespace mpm
   }
 
   template <int dim>
-  std::unique_ptr<Engine<dim>> make_cuda_engine(BackgroundGrid<dim> &grid,
+  std::unique_ptr<Engine<dim>> make_cuda_engine(const HostGrid<dim, double> &lattice,
                                                 const std::vector<MaterialParameters<double>> &materials,
                                                 const ShapeFunction shape)
   {
@@ -107,13 +112,10 @@ namespace mpm
     AssertThrow(cuda::device_count(&why) > 0,
                 dealii::ExcMessage("Parameter 'Backend/Backend': 'cuda' was asked for, but no CUDA device is usable (" +
                                    why + "). Use 'cpu', or run on a machine with an NVIDIA GPU and driver."));
-    AssertThrow(dealii::Utilities::MPI::n_mpi_processes(grid.communicator) == 1,
-                dealii::ExcMessage("Parameter 'Backend/Backend': 'cuda' runs on one MPI rank only for now."));
-    if (dealii::Utilities::MPI::this_mpi_process(grid.communicator) == 0)
-      std::cout << "  CUDA device: " << cuda::device_description() << std::endl;
-    return std::make_unique<CudaEngine<dim>>(grid, materials, shape);
+    std::cout << "  CUDA device: " << cuda::device_description() << std::endl; // one rank
+    return std::make_unique<CudaEngine<dim>>(lattice, materials, shape);
 #else
-    (void)grid;
+    (void)lattice;
     (void)materials;
     (void)shape;
     AssertThrow(false, dealii::ExcMessage("Parameter 'Backend/Backend': 'cuda' is not available in this build "
@@ -123,8 +125,8 @@ namespace mpm
 #endif
   }
 
-  template std::unique_ptr<Engine<2>> make_cuda_engine(BackgroundGrid<2> &,
+  template std::unique_ptr<Engine<2>> make_cuda_engine(const HostGrid<2, double> &,
                                                        const std::vector<MaterialParameters<double>> &, ShapeFunction);
-  template std::unique_ptr<Engine<3>> make_cuda_engine(BackgroundGrid<3> &,
+  template std::unique_ptr<Engine<3>> make_cuda_engine(const HostGrid<3, double> &,
                                                        const std::vector<MaterialParameters<double>> &, ShapeFunction);
 } // namespace mpm

@@ -13,17 +13,30 @@ namespace mpm
     class CpuEngine : public Engine<dim>
     {
     public:
-      CpuEngine(BackgroundGrid<dim> &grid, const std::vector<MaterialParameters<double>> &materials,
+      // One rank: the engine's own nodes on the lattice, no exchange.
+      CpuEngine(const HostGrid<dim, double> &lattice, const std::vector<MaterialParameters<double>> &materials,
                 const ShapeFunction shape)
-        : grid(grid)
+        : own_nodes(lattice)
         , materials(materials)
         , shape(shape)
       {
-        long n_cells = 1;
+        own_nodes.allocate_cells();
+      }
+
+      // Several ranks: the grid's vectors are the nodal arrays, summed over ranks.
+      CpuEngine(BackgroundGrid<dim> &grid, const std::vector<MaterialParameters<double>> &materials,
+                const ShapeFunction shape)
+        : shared_grid(&grid)
+        , materials(materials)
+        , shape(shape)
+      {
+        own_nodes.h = grid.h;
         for (int d = 0; d < dim; ++d)
-          n_cells *= grid.n_cells[d];
-        cell_volume.assign(n_cells, 0.);
-        cell_pressure_volume.assign(n_cells, 0.);
+          {
+            own_nodes.origin[d]  = grid.origin[d];
+            own_nodes.n_cells[d] = grid.n_cells[d];
+          }
+        own_nodes.allocate_cells(); // the pressure averaging's cell sums
       }
 
       void load(const MaterialPoints<dim> &p) override
@@ -33,6 +46,13 @@ namespace mpm
         labels = std::move(new_labels); // a snapshot being written keeps the old ones
       }
 
+      void load(const HostPoints<dim, double> &p, std::shared_ptr<const PointLabels<dim>> new_labels) override
+      {
+        points = p;
+        home_cells.clear(); // asked for on several ranks only, which load from the handler
+        labels = std::move(new_labels);
+      }
+
       unsigned int store(MaterialPoints<dim> &p) override
       {
         const unsigned int removed = p.copy_from(points);
@@ -40,30 +60,41 @@ namespace mpm
         return removed;
       }
 
-      // The grid's vectors are the engine's nodal arrays: already up to date.
       void snapshot(PointSnapshot<dim> &s) override
       {
         s.points = points;
         s.labels = labels;
       }
 
+      // Own nodes: copied into the grid's numbering. Shared ones are already there.
+      void nodal_to(BackgroundGrid<dim> &grid) override
+      {
+        if (shared_grid != nullptr)
+          return;
+        const GridView<dim, double> to = grid.view();
+        const long                  n  = static_cast<long>(own_nodes.mass.size());
+        for (long l = 0; l < n; ++l)
+          {
+            const int node = to.lattice_to_node[l];
+            to.mass[node]  = own_nodes.mass[l];
+            for (int d = 0; d < dim; ++d)
+              to.velocity[d][node] = own_nodes.velocity[d][l];
+          }
+      }
+
       double max_distance_outside_home_cells() override
       {
+        AssertThrow(home_cells.size() == static_cast<std::size_t>(points.size()),
+                    dealii::ExcMessage("Internal: the home cells are known only for points loaded from the "
+                                       "ParticleHandler."));
         const auto   view = points.view();
         const long  *home = home_cells.data();
-        const double h    = grid.h;
-        double       origin[dim];
-        int          n_cells[dim];
-        for (int d = 0; d < dim; ++d)
-          {
-            origin[d]  = grid.origin[d];
-            n_cells[d] = grid.n_cells[d];
-          }
+        const auto  &g    = own_nodes;
         return backend.reduce_points(
           view.n_points, 0.0,
           [&](const int i) {
             return view.material[i] < 0 ? 0.0 :
-                                          distance_outside_home_cell<dim>(origin, h, n_cells, view.position,
+                                          distance_outside_home_cell<dim>(g.origin, g.h, g.n_cells, view.position,
                                                                           home[i], i);
           },
           [](const double a, const double b) { return a > b ? a : b; });
@@ -71,10 +102,16 @@ namespace mpm
 
       StepReduction<double> step(const StepSettings<dim, double> &s, const double dt) override
       {
-        GridView<dim, double> g  = grid.view();
-        g.cell_volume            = cell_volume.data();
-        g.cell_pressure_volume   = cell_pressure_volume.data();
-        return explicit_step<dim>(backend, shape, g, points.view(), materials.data(), s, dt, grid.exchange());
+        if (shared_grid == nullptr)
+          {
+            GridView<dim, double> g = make_grid_view<dim, double>(own_nodes);
+            g.lattice_to_node       = nullptr; // lattice order: a node's index is its lattice index
+            return explicit_step<dim>(backend, shape, g, points.view(), materials.data(), s, dt, NoGridExchange());
+          }
+        GridView<dim, double> g = shared_grid->view();
+        g.cell_volume           = own_nodes.cell_volume.data();
+        g.cell_pressure_volume  = own_nodes.cell_pressure_volume.data();
+        return explicit_step<dim>(backend, shape, g, points.view(), materials.data(), s, dt, shared_grid->exchange());
       }
 
       PointTotals<dim, double> totals() override { return point_totals<dim>(backend, points.view()); }
@@ -82,16 +119,41 @@ namespace mpm
       void set_materials(const std::vector<MaterialParameters<double>> &m) override { materials = m; }
 
     private:
-      BackgroundGrid<dim>                    &grid;
+      // One rank: the nodes and the cell sums. Several ranks: only the lattice geometry and
+      // the cell sums; the nodes are shared_grid's vectors.
+      HostGrid<dim, double>                   own_nodes;
+      BackgroundGrid<dim>                    *shared_grid = nullptr;
       std::vector<MaterialParameters<double>> materials;
       ShapeFunction                           shape;
       CpuBackend                              backend;
       HostPoints<dim, double>                 points;
       std::vector<long>                       home_cells; // lattice cell of each point at the last sort
       std::shared_ptr<const PointLabels<dim>> labels;     // id, initial position, in the order of points
-      std::vector<double>                     cell_volume, cell_pressure_volume; // pressure-averaging scratch
     };
   } // namespace
+
+  namespace
+  {
+    void refuse_unknown_backend(const std::string &backend)
+    {
+      AssertThrow(false, dealii::ExcMessage("Parameter 'Backend/Backend': '" + backend +
+                                            "' is not available in this build (allowed here: cpu). Build with "
+                                            "-DMPM_WITH_CUDA=ON for cuda."));
+    }
+  } // namespace
+
+  template <int dim>
+  std::unique_ptr<Engine<dim>> make_engine(const std::string &backend, const HostGrid<dim, double> &lattice,
+                                           const std::vector<MaterialParameters<double>> &materials,
+                                           const ShapeFunction shape)
+  {
+    if (backend == "cpu")
+      return std::make_unique<CpuEngine<dim>>(lattice, materials, shape);
+    if (backend == "cuda")
+      return make_cuda_engine<dim>(lattice, materials, shape); // throws where not available
+    refuse_unknown_backend(backend);
+    return nullptr;
+  }
 
   template <int dim>
   std::unique_ptr<Engine<dim>> make_engine(const std::string &backend, BackgroundGrid<dim> &grid,
@@ -100,14 +162,17 @@ namespace mpm
   {
     if (backend == "cpu")
       return std::make_unique<CpuEngine<dim>>(grid, materials, shape);
-    if (backend == "cuda")
-      return make_cuda_engine<dim>(grid, materials, shape); // throws where not available
-    AssertThrow(false, dealii::ExcMessage("Parameter 'Backend/Backend': '" + backend +
-                                          "' is not available in this build (allowed here: cpu). Build with "
-                                          "-DMPM_WITH_CUDA=ON for cuda."));
+    AssertThrow(backend != "cuda",
+                dealii::ExcMessage("Parameter 'Backend/Backend': 'cuda' runs on one MPI rank only for now "
+                                   "(allowed on several ranks: cpu)."));
+    refuse_unknown_backend(backend);
     return nullptr;
   }
 
+  template std::unique_ptr<Engine<2>> make_engine(const std::string &, const HostGrid<2, double> &,
+                                                  const std::vector<MaterialParameters<double>> &, ShapeFunction);
+  template std::unique_ptr<Engine<3>> make_engine(const std::string &, const HostGrid<3, double> &,
+                                                  const std::vector<MaterialParameters<double>> &, ShapeFunction);
   template std::unique_ptr<Engine<2>> make_engine(const std::string &, BackgroundGrid<2> &,
                                                   const std::vector<MaterialParameters<double>> &, ShapeFunction);
   template std::unique_ptr<Engine<3>> make_engine(const std::string &, BackgroundGrid<3> &,

@@ -263,6 +263,75 @@ namespace mpm
   }
 
   template <int dim>
+  void points_of_bodies(const std::vector<GeneratedBody<dim>> &bodies, const HostGrid<dim, double> &lattice,
+                        HostPoints<dim, double> &p, PointLabels<dim> &labels)
+  {
+    // Generation index -> (body, index in the body), and each point's lattice cell.
+    std::vector<std::pair<int, int>> source;
+    std::vector<long>                cell;
+    long                             n_cells = 1;
+    for (int d = 0; d < dim; ++d)
+      n_cells *= lattice.n_cells[d];
+    for (unsigned int b = 0; b < bodies.size(); ++b)
+      for (int k = 0; k < bodies[b].points.size(); ++k)
+        {
+          source.emplace_back(b, k);
+          long c = 0;
+          for (int d = dim - 1; d >= 0; --d)
+            {
+              long i = static_cast<long>(std::floor((bodies[b].points.position[d][k] - lattice.origin[d]) / lattice.h));
+              i      = std::min<long>(std::max<long>(i, 0), lattice.n_cells[d] - 1);
+              c      = c * lattice.n_cells[d] + i;
+            }
+          cell.push_back(c);
+        }
+    // Cell by cell, as in the handler (the points of a cell write the same nodes: the CPU's
+    // scatter runs 12% slower on P2-like scenes in generation order), generation order within
+    // a cell: a stable counting sort.
+    const int         n = static_cast<int>(source.size());
+    std::vector<int>  start(n_cells + 1, 0), order(n);
+    for (const long c : cell)
+      ++start[c + 1];
+    for (long c = 0; c < n_cells; ++c)
+      start[c + 1] += start[c];
+    for (int g = 0; g < n; ++g)
+      order[start[cell[g]]++] = g;
+
+    p.resize(0);
+    p.resize(n); // deformation gradient I, as insert() sets it
+    labels.id.resize(n);
+    for (int d = 0; d < dim; ++d)
+      labels.initial_position[d].resize(n);
+    for (int i = 0; i < n; ++i)
+      {
+        const int                      g = order[i];
+        const HostPoints<dim, double> &b = bodies[source[g].first].points;
+        const int                      k = source[g].second;
+        labels.id[i] = g; // the generation index, as insert() numbers the particles
+        for (int d = 0; d < dim; ++d)
+          {
+            p.position[d][i]                   = b.position[d][k];
+            labels.initial_position[d][i]      = b.position[d][k];
+            p.velocity[d][i]                   = b.velocity[d][k];
+            p.domain_half_length[d][i]         = b.domain_half_length[d][k];
+            p.initial_domain_half_length[d][i] = b.initial_domain_half_length[d][k];
+          }
+        // What insert() takes from a body; strain and plastic strain start at zero.
+        for (int c = 0; c < n_voigt; ++c)
+          {
+            p.stress[c][i] = b.stress[c][k];
+            p.strain[c][i] = 0;
+          }
+        p.mass[i]           = b.mass[k];
+        p.volume[i]         = b.volume[k];
+        p.initial_volume[i] = b.initial_volume[k];
+        p.plastic_strain[i] = 0;
+        p.material_field[i] = b.material_field[k];
+        p.material[i]       = b.material[k];
+      }
+  }
+
+  template <int dim>
   void MaterialPoints<dim>::copy_to(HostPoints<dim, double> &p, std::vector<long> *home_cells,
                                     PointLabels<dim> *labels) const
   {
@@ -424,5 +493,9 @@ namespace mpm
   template class MaterialPoints<2>;
   template class MaterialPoints<3>;
   template std::vector<GeneratedBody<2>> generate_bodies<2>(const Parameters &);
+  template void points_of_bodies(const std::vector<GeneratedBody<2>> &, const HostGrid<2, double> &,
+                                 HostPoints<2, double> &, PointLabels<2> &);
+  template void points_of_bodies(const std::vector<GeneratedBody<3>> &, const HostGrid<3, double> &,
+                                 HostPoints<3, double> &, PointLabels<3> &);
   template std::vector<GeneratedBody<3>> generate_bodies<3>(const Parameters &);
 } // namespace mpm

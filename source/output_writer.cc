@@ -403,7 +403,7 @@ namespace mpm
   template <int dim>
   void OutputWriter<dim>::write_history(const HistoryRow &r)
   {
-    if (dealii::Utilities::MPI::this_mpi_process(communicator) != 0)
+    if (rank != 0) // no MPI call: one-rank runs write history while the grid is built on a thread
       return;
     history << r.time << ',' << r.dt << ',' << r.step << ',' << r.totals.kinetic_energy << ','
             << r.work_of_gravity << ',' << r.totals.mass;

@@ -70,34 +70,104 @@ namespace mpm
     dealii::ConditionalOStream pcout(std::cout, dealii::Utilities::MPI::this_mpi_process(communicator) == 0);
     dealii::TimerOutput timer(communicator, pcout, dealii::TimerOutput::summary, dealii::TimerOutput::wall_times);
     const auto wall_start = std::chrono::steady_clock::now();
+    auto       seconds_since = [](const std::chrono::steady_clock::time_point t) {
+      return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+    };
+    const unsigned int n_ranks  = dealii::Utilities::MPI::n_mpi_processes(communicator);
+    const bool         parallel = n_ranks > 1;
 
-    // Set-up: grid, material points, engine, output. The CUDA context is created on a
-    // thread of its own meanwhile (0.3-0.5 s on the GPU host), and the bodies' points on
-    // another (they need the lattice only); they go into the handler once the grid exists.
+    // Set-up. The CUDA context is created on a thread of its own (0.3-0.5 s on the GPU
+    // host) and the bodies' points on another (they need the lattice only).
     std::future<void> cuda_ready;
     if (parameters.backend == "cuda")
       cuda_ready = start_cuda_initialisation();
-    auto bodies = std::async(std::launch::async, [this]() { return generate_bodies<dim>(parameters); });
-    timer.enter_subsection("setup: grid");
-    BackgroundGrid<dim> grid(parameters, communicator);
-    timer.leave_subsection();
-    timer.enter_subsection("setup: material points");
-    MaterialPoints<dim> points(grid, parameters);
-    points.insert(bodies.get());
-    timer.leave_subsection();
-    timer.enter_subsection("setup: engine and output");
-    const long n_points_initial = static_cast<long>(points.handler.n_global_particles());
-    AssertThrow(n_points_initial > 0,
-                dealii::ExcMessage("Parameter 'Material points': the bodies contain no material point (each body "
-                                   "must cover at least one point site of the grid)."));
-    // Before the plasticity start time every model behaves elastically.
+    std::shared_future<std::vector<GeneratedBody<dim>>> generation =
+      std::async(std::launch::async, [this]() { return generate_bodies<dim>(parameters); }).share();
+    // Declared before the output, whose background tasks read the grid: destroyed after it.
+    std::unique_ptr<BackgroundGrid<dim>> grid;
+    std::unique_ptr<MaterialPoints<dim>> points;
+    std::unique_ptr<Engine<dim>>         engine;
+    OutputWriter<dim> output(parameters, communicator); // MPI (a broadcast): before the grid thread starts
+    // Before plasticity start time every model behaves elastically.
     std::vector<MaterialParameters<double>> materials = parameters.materials;
     bool plastic = !(parameters.plasticity_start_time > 0);
     for (auto &m : materials)
       m.plasticity_enabled = plastic;
-    OutputWriter<dim> output(parameters, communicator);
+
+    // One rank: the engine keeps its own nodes on the lattice and starts from the bodies,
+    // so the steps start while deal.II builds the grid and fills the ParticleHandler on a
+    // thread (0.6-1.4 s of the 3D collapse's set-up on the GPU host). deal.II initialises
+    // MPI for serialized calls only, and that thread calls MPI (the Partitioner, the
+    // handler's counts); until it is joined this thread calls none: no reduction over one
+    // rank, no TimerOutput section (its timers call MPI_Comm_size) except the one entered
+    // before the thread starts and left after it is joined, and no output (which needs the
+    // grid: the t = 0 output is written once it exists, a later one waits for it).
+    struct GridAndPoints
+    {
+      std::unique_ptr<BackgroundGrid<dim>> grid;
+      std::unique_ptr<MaterialPoints<dim>> points;
+      double                               seconds = 0;
+    };
+    // Every rank generates every body, so these need no communication.
+    long   n_points_initial = 0;
+    double m_min            = 1e300;
+    auto   count_points     = [&]() {
+      for (const GeneratedBody<dim> &body : generation.get())
+        {
+          n_points_initial += body.points.size();
+          for (const double m : body.points.mass)
+            m_min = std::min(m_min, m);
+        }
+      AssertThrow(n_points_initial > 0,
+                  dealii::ExcMessage("Parameter 'Material points': the bodies contain no material point (each "
+                                     "body must cover at least one point site of the grid)."));
+    };
+
+    std::future<GridAndPoints> grid_build;
+    const std::string          beside_grid = "setup and first steps, beside deal.II's grid";
+    double                     engine_setup_seconds = 0;
+    if (!parallel)
+      {
+        timer.enter_subsection(beside_grid);
+        grid_build = std::async(std::launch::async, [this, generation]() {
+          const auto    start = std::chrono::steady_clock::now();
+          GridAndPoints built;
+          built.grid   = std::make_unique<BackgroundGrid<dim>>(parameters, communicator);
+          built.points = std::make_unique<MaterialPoints<dim>>(*built.grid, parameters);
+          built.points->insert(generation.get());
+          built.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+          return built;
+        });
+        const auto start = std::chrono::steady_clock::now();
+        count_points();
+        auto       host  = std::make_unique<HostPoints<dim, double>>();
+        auto       labels = std::make_shared<PointLabels<dim>>();
+        points_of_bodies(generation.get(), lattice_geometry<dim>(parameters), *host, *labels);
+        if (cuda_ready.valid())
+          cuda_ready.get();
+        engine = make_engine<dim>(parameters.backend, lattice_grid<dim>(parameters), materials,
+                                  parameters.shape_function);
+        engine->set_sort_interval(parameters.sort_interval);
+        engine->load(*host, std::move(labels));
+        engine_setup_seconds = seconds_since(start);
+      }
+    else
+      {
+        timer.enter_subsection("setup: grid");
+        grid = std::make_unique<BackgroundGrid<dim>>(parameters, communicator);
+        timer.leave_subsection();
+        timer.enter_subsection("setup: material points");
+        count_points();
+        points = std::make_unique<MaterialPoints<dim>>(*grid, parameters);
+        points->insert(generation.get());
+        timer.leave_subsection();
+      }
+    // Reductions over the ranks; on one rank the value itself, without an MPI call.
+    auto global_max = [&](const double x) { return parallel ? max(x, communicator) : x; };
+    auto global_min = [&](const double x) { return parallel ? min(x, communicator) : x; };
+    auto global_sum = [&](const double x) { return parallel ? sum(x, communicator) : x; };
+
     // MPI: points re-sorted into cells and ranks, grid repartitioned by work.
-    const bool   parallel  = dealii::Utilities::MPI::n_mpi_processes(communicator) > 1;
     // Pressure averaging in parallel: a point's cell at the end of a step must be an owned
     // or ghost cell of its rank (whose cell sums the exchange covers), i.e. less than one
     // cell outside its home cell. Re-sorting at half a cell (GIMP's safe distance already)
@@ -114,73 +184,113 @@ namespace mpm
     auto balance = [&]() {
       if (!parallel || !(parameters.load_balance_threshold > 0))
         return false;
-      const double before = points.imbalance();
+      const double before = points->imbalance();
       if (before <= parameters.load_balance_threshold ||
           before <= balanced + 0.5 * (parameters.load_balance_threshold - 1))
         return false;
       dealii::TimerOutput::Scope scope(timer, "repartition");
       output.finish(); // a grid output in flight reads the DoFHandler
-      points.repartition();
+      points->repartition();
       ++n_repartitions;
-      balanced = points.imbalance();
+      balanced = points->imbalance();
       pcout << "  repartitioned the grid by work: max/mean work per rank " << before << " -> " << balanced
             << std::endl;
       return true;
     };
-    balance();
-    if (cuda_ready.valid())
-      cuda_ready.get();
-    auto engine = make_engine<dim>(parameters.backend, grid, materials, parameters.shape_function);
-    engine->set_sort_interval(parameters.sort_interval);
-    engine->load(points);
-    timer.leave_subsection();
+    if (parallel)
+      {
+        timer.enter_subsection("setup: engine");
+        balance();
+        engine = make_engine<dim>(parameters.backend, *grid, materials, parameters.shape_function);
+        engine->set_sort_interval(parameters.sort_interval);
+        engine->load(*points);
+        timer.leave_subsection();
+      }
 
-    pcout << "dealii-mpm: " << dim << "D, " << grid.triangulation.n_global_active_cells() << " cells, "
-          << grid.dof_handler.n_dofs() << " nodes, " << n_points_initial << " material points, "
-          << dealii::Utilities::MPI::n_mpi_processes(communicator) << " MPI rank(s), backend "
-          << parameters.backend << "\n"
+    const HostGrid<dim, double> lattice = lattice_geometry<dim>(parameters);
+    long                        n_cells = 1, n_nodes = 1;
+    for (int d = 0; d < dim; ++d)
+      {
+        n_cells *= lattice.n_cells[d];
+        n_nodes *= lattice.n_cells[d] + 1;
+      }
+    pcout << "dealii-mpm: " << dim << "D, " << n_cells << " cells, " << n_nodes << " nodes, " << n_points_initial
+          << " material points, " << n_ranks << " MPI rank(s), backend " << parameters.backend << "\n"
           << "  elastic wave speed " << c_el << " m/s, end time " << parameters.end_time << " s, output in '"
           << output.directory() << "'" << std::endl;
 
     StepSettings<dim, double> settings;
-    settings.scheme         = parameters.scheme;
-    settings.damping        = parameters.damping;
-    settings.flip_fraction  = parameters.flip_fraction;
-    settings.domain_update  = parameters.domain_update;
+    settings.scheme             = parameters.scheme;
+    settings.damping            = parameters.damping;
+    settings.flip_fraction      = parameters.flip_fraction;
+    settings.domain_update      = parameters.domain_update;
     settings.pressure_averaging = parameters.pressure_averaging;
-    settings.mass_tolerance = 0;
-    {
-      // Nodes lighter than 1e-12 of the smallest point carry no velocity.
-      double m_min = 1e300;
-      for (const auto &p : points.handler)
-        m_min = std::min(m_min, p.get_properties()[PropertyLayout<dim>::mass]);
-      settings.mass_tolerance = 1e-12 * min(m_min, communicator);
-    }
+    settings.mass_tolerance     = 1e-12 * m_min; // nodes lighter than that carry no velocity
 
     double time = 0, max_speed = 0, max_removed_speed = 0, work_of_gravity = 0, dt = 0;
     long   step = 0, n_removed = 0;
     double next_output = parameters.output_interval;
     auto   last_progress = std::chrono::steady_clock::now();
 
+    // A TimerOutput section, except while the grid thread runs (then the time counts to
+    // the section entered before it started).
+    auto timed = [&](const char *section, auto &&work) {
+      if (grid_build.valid())
+        return work();
+      dealii::TimerOutput::Scope scope(timer, section);
+      return work();
+    };
+
+    // The t = 0 output of a one-rank run, taken before the grid exists and written once it does.
+    bool initial_output_pending = false;
+    // Joins the grid thread (waits for it where it is still running): from here on the
+    // grid and the handler exist and MPI may be called again.
+    auto join_grid = [&]() {
+      if (!grid_build.valid())
+        return;
+      GridAndPoints built = grid_build.get();
+      grid                = std::move(built.grid);
+      points              = std::move(built.points);
+      timer.leave_subsection(beside_grid);
+      pcout << "  deal.II's grid and ParticleHandler built on a thread in " << built.seconds
+            << " s, beside the engine's set-up (" << engine_setup_seconds << " s) and the first " << step
+            << " steps" << std::endl;
+      if (initial_output_pending)
+        {
+          dealii::TimerOutput::Scope scope(timer, "output");
+          output.write_fields(0, *grid); // before the first step every nodal field is zero
+          initial_output_pending = false;
+        }
+    };
+
     auto record_history = [&]() {
-      dealii::TimerOutput::Scope scope(timer, "history");
-      const auto local  = engine->totals();
-      const auto totals = global_totals<dim>(local, communicator);
-      n_removed         = n_points_initial - totals.n_points;
-      typename OutputWriter<dim>::HistoryRow row{time, dt, work_of_gravity, step, n_removed, totals};
-      row.min_points_per_rank = static_cast<long>(min(double(local.n_points), communicator));
-      row.max_points_per_rank = static_cast<long>(max(double(local.n_points), communicator));
-      row.n_resorts           = n_resorts;
-      row.n_repartitions      = n_repartitions;
-      row.n_sent              = static_cast<long>(sum(double(points.n_sent), communicator));
-      output.write_history(row);
+      timed("history", [&]() {
+        const auto local  = engine->totals();
+        const auto totals = parallel ? global_totals<dim>(local, communicator) : local;
+        n_removed         = n_points_initial - totals.n_points;
+        typename OutputWriter<dim>::HistoryRow row{time, dt, work_of_gravity, step, n_removed, totals};
+        row.min_points_per_rank = static_cast<long>(global_min(double(local.n_points)));
+        row.max_points_per_rank = static_cast<long>(global_max(double(local.n_points)));
+        row.n_resorts           = n_resorts;
+        row.n_repartitions      = n_repartitions;
+        row.n_sent              = parallel ? static_cast<long>(sum(double(points->n_sent), communicator)) : 0;
+        output.write_history(row);
+      });
     };
     // Output reads a snapshot of the engine's points: no hand-over to the handler, which
-    // is brought up to date only where it is needed (re-sorts, repartitions, end of run).
+    // is brought up to date only where it is needed (re-sorts, repartitions).
     auto write_output = [&]() {
+      if (time == 0 && grid_build.valid())
+        {
+          engine->snapshot(output.next_snapshot());
+          initial_output_pending = true;
+          return;
+        }
+      join_grid();
       dealii::TimerOutput::Scope scope(timer, "output");
       engine->snapshot(output.next_snapshot());
-      output.write_fields(time, grid);
+      engine->nodal_to(*grid);
+      output.write_fields(time, *grid);
     };
 
     write_output();
@@ -189,6 +299,9 @@ namespace mpm
     const double end = parameters.end_time;
     while (time < end * (1 - 1e-12) && (parameters.max_steps == 0 || step < long(parameters.max_steps)))
       {
+        if (grid_build.valid() && grid_build.wait_for(std::chrono::seconds(0)) == std::future_status::ready)
+          join_grid();
+
         dt = parameters.adaptive_time_step ? parameters.cfl * h / (c_el + max_speed) : parameters.fixed_time_step;
         dt = std::min(dt, end - time);
         if (parameters.output_interval > 0)
@@ -207,40 +320,38 @@ namespace mpm
             pcout << "  plasticity switched on at t = " << time << " s" << std::endl;
           }
 
-        StepReduction<double> r;
-        {
-          dealii::TimerOutput::Scope scope(timer, "MPM step");
-          r = engine->step(settings, dt);
-        }
+        const StepReduction<double> r = timed("MPM step", [&]() { return engine->step(settings, dt); });
         // One reduction for the next time step and the migration test: the largest
         // speed and the largest distance of a point outside its home cell.
-        {
-          double local[3] = {r.max_speed, parallel ? engine->max_distance_outside_home_cells() : 0.0,
-                             r.max_removed_speed},
-                 global[3];
-          dealii::Utilities::MPI::max(dealii::ArrayView<const double>(local, 3), communicator,
-                                      dealii::ArrayView<double>(global, 3));
-          max_speed         = global[0];
-          max_removed_speed = global[2];
-          AssertThrow(!(parallel && parameters.pressure_averaging) || global[1] < 1,
-                      dealii::ExcMessage("Parameter 'Solver/Pressure averaging': at t = " +
-                                         dealii::Utilities::to_string(time + dt) + " s a point moved to " +
-                                         dealii::Utilities::to_string(global[1]) +
-                                         " cells outside the cell it was sorted into, beyond the ghost cells whose "
-                                         "pressure sums are exchanged between ranks. Reduce 'Solver/CFL number' or "
-                                         "the time step."));
-          if (parallel && global[1] >= resort_at)
-            {
+        max_speed         = r.max_speed;
+        max_removed_speed = r.max_removed_speed;
+        if (parallel)
+          {
+            double local[3] = {r.max_speed, engine->max_distance_outside_home_cells(), r.max_removed_speed},
+                   global[3];
+            dealii::Utilities::MPI::max(dealii::ArrayView<const double>(local, 3), communicator,
+                                        dealii::ArrayView<double>(global, 3));
+            max_speed         = global[0];
+            max_removed_speed = global[2];
+            AssertThrow(!parameters.pressure_averaging || global[1] < 1,
+                        dealii::ExcMessage("Parameter 'Solver/Pressure averaging': at t = " +
+                                           dealii::Utilities::to_string(time + dt) + " s a point moved to " +
+                                           dealii::Utilities::to_string(global[1]) +
+                                           " cells outside the cell it was sorted into, beyond the ghost cells "
+                                           "whose pressure sums are exchanged between ranks. Reduce 'Solver/CFL "
+                                           "number' or the time step."));
+            if (global[1] >= resort_at)
               {
-                dealii::TimerOutput::Scope scope(timer, "migrate points");
-                engine->store(points);
-                ++n_resorts;
+                {
+                  dealii::TimerOutput::Scope scope(timer, "migrate points");
+                  engine->store(*points);
+                  ++n_resorts;
+                }
+                if (balance())
+                  engine->load(*points);
               }
-              if (balance())
-                engine->load(points);
-            }
-        }
-        work_of_gravity += dt * sum(r.gravity_power, communicator);
+          }
+        work_of_gravity += dt * global_sum(r.gravity_power);
         time += dt;
         ++step;
         // A blow-up shows as a non-finite velocity or, with the adaptive step, as speeds that
@@ -274,6 +385,7 @@ namespace mpm
           }
       }
 
+    join_grid(); // a short run may end before the grid thread does
     if (step % parameters.history_every != 0)
       record_history();
     if (!(parameters.output_interval > 0 && std::abs(time - (next_output - parameters.output_interval)) < 1e-12 * end))
@@ -293,15 +405,15 @@ namespace mpm
           << " material point(s) left the grid and were removed.\n";
     if (parallel)
       pcout << "  MPI: " << n_resorts << " re-sorts of the points into cells and ranks, "
-            << static_cast<long>(sum(double(points.n_sent), communicator)) << " points migrated, "
-            << n_repartitions << " repartitions; work per rank max/mean " << points.imbalance() << "\n";
+            << static_cast<long>(sum(double(points->n_sent), communicator)) << " points migrated, "
+            << n_repartitions << " repartitions; work per rank max/mean " << points->imbalance() << "\n";
     if (parallel)
       {
         // Ghost exchange per step: import + export of every ghost node's value, for each
         // array the scheme sums (MUSL: mass, momentum, force, then momentum again).
-        const double ghosts = grid.partitioner->n_ghost_indices();
+        const double ghosts = grid->partitioner->n_ghost_indices();
         const int    arrays = parameters.scheme == UpdateScheme::musl ? 3 * dim + 1 : 2 * dim + 1;
-        const double bytes  = sum(double(grid.exchange_bytes_per_array()), communicator) * arrays;
+        const double bytes  = sum(double(grid->exchange_bytes_per_array()), communicator) * arrays;
         pcout << "  MPI: ghost nodes " << static_cast<long>(sum(ghosts, communicator)) << " in all, "
               << static_cast<long>(max(ghosts, communicator)) << " at most on one rank; exchange " << bytes
               << " bytes per step (" << arrays << " nodal arrays, each ghost value sent to its owner and back)\n";

@@ -103,8 +103,9 @@ namespace mpm
       long                         n_lattice_cells = 1;
       ShapeFunction                shape;
       ExchangeAdapter              exchange;
-      // Host node number of each device node, where the device renumbered them (empty: same numbering).
-      std::vector<int>             host_node_of_device_node;
+      // The device numbers its nodes in lattice order (one rank, the host's nodes being the
+      // whole lattice); otherwise as the host does.
+      bool                         lattice_order = false;
       // The last step's pressure averaging is left to the next step's P2G (explicit_step);
       // download_points finishes it first.
       bool                         averaging_pending = false;
@@ -146,7 +147,7 @@ namespace mpm
       // nodes are the whole lattice (one rank), the device keeps them in lattice order (x
       // fastest; deal.II numbers the DoFs cell by cell): its grid view then needs no lookup,
       // a node's index is its lattice index (DeviceGrid::lattice_order; 6% off P1's step).
-      // download_nodal puts the values back in the host's order.
+      // download_nodal puts the values back in the order of the host grid it is given.
       std::vector<int> lattice_nodes(g.lattice_to_node, g.lattice_to_node + n_lattice_nodes);
       bool             bijection = exchange == nullptr && g.n_nodes == n_lattice_nodes;
       std::vector<char> seen(bijection ? g.n_nodes : 0, 0);
@@ -160,7 +161,7 @@ namespace mpm
       host.allocate_nodes(g.n_nodes);
       if (bijection)
         {
-          impl->host_node_of_device_node = lattice_nodes;
+          impl->lattice_order = true;
           host.lattice_to_node.resize(n_lattice_nodes);
           for (long l = 0; l < n_lattice_nodes; ++l)
             {
@@ -218,10 +219,12 @@ namespace mpm
       const size_t bytes = dg.mass.bytes();
       if (static_cast<size_t>(g.n_nodes) != dg.mass.size())
         throw std::invalid_argument("DeviceEngine::download_nodal: the host grid has another number of nodes");
-      const std::vector<int> &host_node = impl->host_node_of_device_node;
-      std::vector<double>     staging(host_node.empty() ? 0 : dg.mass.size());
+      // Lattice order on the device: device node l is the host's node g.lattice_to_node[l]
+      // (the identity where the host grid has no lookup).
+      const int          *host_node = impl->lattice_order ? g.lattice_to_node : nullptr;
+      std::vector<double> staging(host_node == nullptr ? 0 : dg.mass.size());
       auto download = [&](double *to, const DeviceArray<double> &from) {
-        if (host_node.empty())
+        if (host_node == nullptr)
           {
             MPM_CUDA_CHECK(cudaMemcpy(to, from.data(), bytes, cudaMemcpyDeviceToHost));
             return;

@@ -7,7 +7,7 @@
 //
 // The host grid description is a GridView<dim, double> whose geometry, lattice
 // lookup (lattice_to_node) and boundary masks (fixed_components) are read once at
-// construction; its nodal arrays are written only by download_nodal().
+// construction; nodal arrays are written only by download_nodal().
 #pragma once
 
 #include <mpm/core/diagnostics.h>
@@ -69,7 +69,10 @@ namespace mpm
       // that the nodal sums of a warp are reduced before the atomics; default 20.
       void set_sort_interval(int steps);
       // Device -> host: nodal mass and velocity (what the output writes) into the host
-      // grid's arrays (same numbering and length as at construction).
+      // grid's arrays: the same lattice and number of nodes as at construction, numbered
+      // as host_grid.lattice_to_node says (which may differ from the construction's where
+      // the host's nodes are the whole lattice: one rank starts from lattice_grid and
+      // writes into deal.II's DoF numbering).
       void download_nodal(const GridView<dim, double> &host_grid) const;
 
       // One step on the device; only the reduction (max speed, power of gravity) comes back.

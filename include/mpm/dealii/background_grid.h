@@ -32,6 +32,13 @@ namespace mpm
   template <int dim>
   HostGrid<dim, double> lattice_geometry(const Parameters &parameters);
 
+  // The nodes of that lattice as an engine on one rank keeps them: every lattice node,
+  // numbered in lattice order (x fastest), nodal arrays zero, and the boundary masks of
+  // Boundary/* as BackgroundGrid sets them from the faces' boundary ids. It needs no
+  // deal.II grid, so one-rank runs start stepping while deal.II builds it.
+  template <int dim>
+  HostGrid<dim, double> lattice_grid(const Parameters &parameters);
+
   template <int dim>
   class BackgroundGrid
   {

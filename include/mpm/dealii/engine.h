@@ -1,8 +1,13 @@
 // Where the MPM step runs. The simulator hands points over at the start and takes
 // them back (store) only when the ParticleHandler must see them (MPI re-sort and
-// repartition, end of run); in between, the engine keeps them in the backend's arrays.
-// Output reads a snapshot of those arrays instead, with no hand-over. CPU here; the
-// CUDA engine implements the same interface over device arrays.
+// repartition); in between, the engine keeps them in the backend's arrays. Output reads
+// a snapshot of those arrays instead, with no hand-over.
+//
+// On one rank an engine keeps its own nodes on the lattice (lattice_grid) and starts
+// from the generated bodies: it needs neither deal.II's grid nor the handler, which are
+// built beside the first steps. On several ranks the nodes are the BackgroundGrid's
+// ghosted vectors, summed over ranks after each scatter. CPU here; the CUDA engine
+// (cuda_engine.h) implements the same interface over device arrays, on one rank.
 #pragma once
 
 #include <mpm/core/diagnostics.h>
@@ -21,15 +26,21 @@ namespace mpm
   {
   public:
     virtual ~Engine() = default;
-    virtual void                    load(const MaterialPoints<dim> &points)           = 0;
+    // The handler's points (MPI re-sorts and repartitions).
+    virtual void load(const MaterialPoints<dim> &points) = 0;
+    // Points given as arrays, with their labels in the same order (points_of_bodies).
+    virtual void load(const HostPoints<dim, double> &points, std::shared_ptr<const PointLabels<dim>> labels) = 0;
     virtual unsigned int            store(MaterialPoints<dim> &points)                = 0;
     virtual StepReduction<double>   step(const StepSettings<dim, double> &s, double dt) = 0;
     virtual PointTotals<dim, double> totals()                                         = 0;
     // For output: copies the points as they are now into snapshot.points (engine order,
-    // points that left the grid included with material < 0), sets snapshot.labels, and
-    // brings the grid's nodal vectors up to date (mass, velocity) where the engine keeps
-    // its own copy. The handler is not touched.
+    // points that left the grid included with material < 0) and sets snapshot.labels.
+    // The handler is not touched.
     virtual void snapshot(PointSnapshot<dim> &snapshot) = 0;
+    // For output: brings the grid's nodal vectors (mass, velocity) up to date where the
+    // engine keeps its own nodes. Before the first step every nodal field is zero, in the
+    // engine as in a grid just built.
+    virtual void nodal_to(BackgroundGrid<dim> &grid) = 0;
     // Largest distance of a point outside the cell it was sorted into at the last
     // load/store, in cell units (max-norm); MPI runs re-sort before it gets unsafe.
     // An engine that does not track it makes MPI runs re-sort after every step.
@@ -41,7 +52,14 @@ namespace mpm
     virtual void set_materials(const std::vector<MaterialParameters<double>> &materials) = 0;
   };
 
-  // Throws naming Backend/Backend if the requested backend is not available.
+  // One rank: the engine's own nodes on the lattice (lattice_grid: geometry and boundary
+  // masks). Throws naming Backend/Backend if the requested backend is not available.
+  template <int dim>
+  std::unique_ptr<Engine<dim>> make_engine(const std::string &backend, const HostGrid<dim, double> &lattice,
+                                           const std::vector<MaterialParameters<double>> &materials,
+                                           ShapeFunction shape);
+
+  // Several ranks: the nodes are the grid's vectors (cpu only for now).
   template <int dim>
   std::unique_ptr<Engine<dim>> make_engine(const std::string &backend, BackgroundGrid<dim> &grid,
                                            const std::vector<MaterialParameters<double>> &materials,

@@ -79,6 +79,16 @@ namespace mpm
   template <int dim>
   std::vector<GeneratedBody<dim>> generate_bodies(const Parameters &parameters);
 
+  // The bodies' points as the core's arrays, with their labels, exactly as
+  // MaterialPoints::insert followed by copy_to gives them on one rank, and like them
+  // cell by cell (lattice cells of `lattice`, in lattice order; the handler's cells are in
+  // deal.II's order), in generation order within a cell. The ids are the generation
+  // index, as insert gives them. One-rank runs load their engine from this while deal.II
+  // builds the grid and the handler.
+  template <int dim>
+  void points_of_bodies(const std::vector<GeneratedBody<dim>> &bodies, const HostGrid<dim, double> &lattice,
+                        HostPoints<dim, double> &points, PointLabels<dim> &labels);
+
   template <int dim>
   class MaterialPoints
   {
