@@ -94,20 +94,6 @@ namespace mpm
     for (auto &m : materials)
       m.plasticity_enabled = plastic;
 
-    // One rank: the engine keeps its own nodes on the lattice and starts from the bodies,
-    // so the steps start while deal.II builds the grid and fills the ParticleHandler on a
-    // thread (0.6-1.4 s of the 3D collapse's set-up on the GPU host). deal.II initialises
-    // MPI for serialized calls only, and that thread calls MPI (the Partitioner, the
-    // handler's counts); until it is joined this thread calls none: no reduction over one
-    // rank, no TimerOutput section (its timers call MPI_Comm_size) except the one entered
-    // before the thread starts and left after it is joined, and no output (which needs the
-    // grid: the t = 0 output is written once it exists, a later one waits for it).
-    struct GridAndPoints
-    {
-      std::unique_ptr<BackgroundGrid<dim>> grid;
-      std::unique_ptr<MaterialPoints<dim>> points;
-      double                               seconds = 0;
-    };
     // Every rank generates every body, so these need no communication.
     long   n_points_initial = 0;
     double m_min            = 1e300;
@@ -123,6 +109,20 @@ namespace mpm
                                      "body must cover at least one point site of the grid)."));
     };
 
+    // One rank: the engine keeps its own nodes on the lattice and starts from the bodies,
+    // so the steps start while deal.II builds the grid and fills the ParticleHandler on a
+    // thread (0.6-1.4 s of the 3D collapse's set-up on the GPU host). deal.II initialises
+    // MPI for serialized calls only, and that thread calls MPI (the Partitioner, the
+    // handler's counts); until it is joined this thread calls none: no reduction over one
+    // rank, no TimerOutput section (its timers call MPI_Comm_size) except the one entered
+    // before the thread starts and left after it is joined, and no output (which needs the
+    // grid: the t = 0 output is written once it exists, a later one waits for it).
+    struct GridAndPoints
+    {
+      std::unique_ptr<BackgroundGrid<dim>> grid;
+      std::unique_ptr<MaterialPoints<dim>> points;
+      double                               seconds = 0;
+    };
     std::future<GridAndPoints> grid_build;
     const std::string          beside_grid = "setup and first steps, beside deal.II's grid";
     double                     engine_setup_seconds = 0;
@@ -140,15 +140,15 @@ namespace mpm
         });
         const auto start = std::chrono::steady_clock::now();
         count_points();
-        auto       host  = std::make_unique<HostPoints<dim, double>>();
-        auto       labels = std::make_shared<PointLabels<dim>>();
-        points_of_bodies(generation.get(), lattice_geometry<dim>(parameters), *host, *labels);
+        HostPoints<dim, double> host;
+        auto                    labels = std::make_shared<PointLabels<dim>>();
+        points_of_bodies(generation.get(), lattice_geometry<dim>(parameters), host, *labels);
         if (cuda_ready.valid())
           cuda_ready.get();
         engine = make_engine<dim>(parameters.backend, lattice_grid<dim>(parameters), materials,
                                   parameters.shape_function);
         engine->set_sort_interval(parameters.sort_interval);
-        engine->load(*host, std::move(labels));
+        engine->load(host, std::move(labels));
         engine_setup_seconds = seconds_since(start);
       }
     else
