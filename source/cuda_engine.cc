@@ -91,6 +91,15 @@ namespace mpm
   } // namespace
 #endif
 
+  bool cuda_engine_built()
+  {
+#ifdef MPM_CUDA_ENGINE
+    return true;
+#else
+    return false;
+#endif
+  }
+
   std::future<void> start_cuda_initialisation()
   {
 #ifdef MPM_CUDA_ENGINE

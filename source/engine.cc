@@ -162,6 +162,8 @@ namespace mpm
   {
     if (backend == "cpu")
       return std::make_unique<CpuEngine<dim>>(grid, materials, shape);
+    if (backend == "cuda" && !cuda_engine_built())
+      refuse_unknown_backend(backend);
     AssertThrow(backend != "cuda",
                 dealii::ExcMessage("Parameter 'Backend/Backend': 'cuda' runs on one MPI rank only for now "
                                    "(allowed on several ranks: cpu)."));

@@ -13,6 +13,9 @@ namespace mpm
   // result before make_cuda_engine. A ready future in builds without CUDA.
   std::future<void> start_cuda_initialisation();
 
+  // Whether this build has the CUDA engine (configured with -DMPM_WITH_CUDA=ON).
+  bool cuda_engine_built();
+
   // Throws naming Backend/Backend where this build has no CUDA engine (configured
   // without -DMPM_WITH_CUDA=ON) or where no CUDA device is found. On several ranks
   // make_engine refuses cuda before this is reached.
