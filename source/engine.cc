@@ -132,27 +132,26 @@ namespace mpm
     };
   } // namespace
 
-  namespace
+  void check_backend(const std::string &backend, const unsigned int n_ranks)
   {
-    void refuse_unknown_backend(const std::string &backend)
-    {
-      AssertThrow(false, dealii::ExcMessage("Parameter 'Backend/Backend': '" + backend +
-                                            "' is not available in this build (allowed here: cpu). Build with "
-                                            "-DMPM_WITH_CUDA=ON for cuda."));
-    }
-  } // namespace
+    AssertThrow(backend == "cpu" || (backend == "cuda" && cuda_engine_built()),
+                dealii::ExcMessage("Parameter 'Backend/Backend': '" + backend +
+                                   "' is not available in this build (allowed here: cpu). Build with "
+                                   "-DMPM_WITH_CUDA=ON for cuda."));
+    AssertThrow(backend == "cpu" || n_ranks == 1,
+                dealii::ExcMessage("Parameter 'Backend/Backend': 'cuda' runs on one MPI rank only for now "
+                                   "(allowed on " + std::to_string(n_ranks) + " ranks: cpu)."));
+  }
 
   template <int dim>
   std::unique_ptr<Engine<dim>> make_engine(const std::string &backend, const HostGrid<dim, double> &lattice,
                                            const std::vector<MaterialParameters<double>> &materials,
                                            const ShapeFunction shape)
   {
-    if (backend == "cpu")
-      return std::make_unique<CpuEngine<dim>>(lattice, materials, shape);
+    check_backend(backend, 1);
     if (backend == "cuda")
-      return make_cuda_engine<dim>(lattice, materials, shape); // throws where not available
-    refuse_unknown_backend(backend);
-    return nullptr;
+      return make_cuda_engine<dim>(lattice, materials, shape); // throws where no device is found
+    return std::make_unique<CpuEngine<dim>>(lattice, materials, shape);
   }
 
   template <int dim>
@@ -160,15 +159,9 @@ namespace mpm
                                            const std::vector<MaterialParameters<double>> &materials,
                                            const ShapeFunction shape)
   {
-    if (backend == "cpu")
-      return std::make_unique<CpuEngine<dim>>(grid, materials, shape);
-    if (backend == "cuda" && !cuda_engine_built())
-      refuse_unknown_backend(backend);
-    AssertThrow(backend != "cuda",
-                dealii::ExcMessage("Parameter 'Backend/Backend': 'cuda' runs on one MPI rank only for now "
-                                   "(allowed on several ranks: cpu)."));
-    refuse_unknown_backend(backend);
-    return nullptr;
+    check_backend(backend, grid.n_ranks);
+    AssertThrow(backend == "cpu", dealii::ExcMessage("Internal: the CUDA engine runs on its own lattice nodes."));
+    return std::make_unique<CpuEngine<dim>>(grid, materials, shape);
   }
 
   template std::unique_ptr<Engine<2>> make_engine(const std::string &, const HostGrid<2, double> &,

@@ -67,14 +67,16 @@ namespace mpm
                                      " s exceeds the elastic stability limit h / c_el = " +
                                      dealii::Utilities::to_string(h / c_el) + " s (CFL > 1)."));
 
+    const unsigned int n_ranks  = dealii::Utilities::MPI::n_mpi_processes(communicator);
+    const bool         parallel = n_ranks > 1;
+    check_backend(parameters.backend, n_ranks); // before any set-up
+
     dealii::ConditionalOStream pcout(std::cout, dealii::Utilities::MPI::this_mpi_process(communicator) == 0);
     dealii::TimerOutput timer(communicator, pcout, dealii::TimerOutput::summary, dealii::TimerOutput::wall_times);
     const auto wall_start = std::chrono::steady_clock::now();
     auto       seconds_since = [](const std::chrono::steady_clock::time_point t) {
       return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
     };
-    const unsigned int n_ranks  = dealii::Utilities::MPI::n_mpi_processes(communicator);
-    const bool         parallel = n_ranks > 1;
 
     // Set-up. The CUDA context is created on a thread of its own (0.3-0.5 s on the GPU
     // host) and the bodies' points on another (they need the lattice only).

@@ -52,6 +52,10 @@ namespace mpm
     virtual void set_materials(const std::vector<MaterialParameters<double>> &materials) = 0;
   };
 
+  // Throws naming Backend/Backend where the backend cannot run here: not in this build, or
+  // cuda on more than one rank. The simulator asks before any set-up.
+  void check_backend(const std::string &backend, unsigned int n_ranks);
+
   // One rank: the engine's own nodes on the lattice (lattice_grid: geometry and boundary
   // masks). Throws naming Backend/Backend if the requested backend is not available.
   template <int dim>
