@@ -40,8 +40,9 @@ namespace mpm
         device.upload_points(p);
       }
 
-      // End of run: points come back, points that left the grid are removed, the
-      // handler's new order goes back down.
+      // Hand-over to the handler (an MPI re-sort; the CUDA engine runs on one rank, where
+      // nothing calls it yet): points come back, points that left the grid are removed,
+      // the handler's new order goes back down.
       unsigned int store(MaterialPoints<dim> &p) override
       {
         host.resize(device.n_points());
