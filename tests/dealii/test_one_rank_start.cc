@@ -14,6 +14,7 @@
 #include <deal.II/base/mpi.h>
 
 #include "../core/check.h"
+#include "box_scene.h"
 
 #include <cstring>
 #include <string>
@@ -23,38 +24,26 @@ namespace
 {
   using namespace mpm;
 
+  // Two bodies (one geostatic, one moving, of other materials) falling in a box whose
+  // faces have every type of boundary.
   template <int dim>
   Parameters scene()
   {
-    Parameters p;
-    p.dim       = dim;
-    p.lower     = std::vector<double>(dim, 0.0);
-    p.upper     = std::vector<double>(dim, 0.08);
-    p.upper[0]  = 0.12;
-    p.cell_size = 0.01;
+    Parameters p = mpm_test::box_domain<dim>(0.08, 0.01);
+    p.upper[0]   = 0.12;
     // Every type, on faces of every direction: x min no-slip, x max free-slip, y min free, ...
     p.boundary = {{BoundaryType::no_slip, BoundaryType::free_slip, BoundaryType::free,
                    BoundaryType::free_slip, BoundaryType::no_slip, BoundaryType::free}};
     if (dim == 2)
       p.boundary[2] = BoundaryType::no_slip; // the floor
-    BodyParameters body;
-    body.shape                = "box";
-    body.lower                = std::vector<double>(dim, 0.0);
-    body.upper                = std::vector<double>(dim, 0.04);
-    body.points_per_direction = 2;
-    body.density              = 2000;
-    body.velocity             = std::vector<double>(dim, 0.0);
-    body.initial_stress       = "geostatic";
-    body.k0                   = 0.4;
-    BodyParameters second     = body;
-    second.lower              = std::vector<double>(dim, 0.045);
-    second.upper              = std::vector<double>(dim, 0.075);
-    second.points_per_direction = 3;
-    second.density            = 1500;
-    second.initial_stress     = "none";
-    second.velocity[0]        = -0.5;
-    p.bodies                  = {body, second};
-    p.body_material           = {0, 1};
+    p.gravity[dim - 1] = -9.81;
+    BodyParameters body  = mpm_test::box_body<dim>(0.0, 0.04, 2, 2000);
+    body.initial_stress  = "geostatic";
+    body.k0              = 0.4;
+    BodyParameters second = mpm_test::box_body<dim>(0.045, 0.075, 3, 1500);
+    second.velocity[0]    = -0.5;
+    p.bodies              = {body, second};
+    p.body_material       = {0, 1};
     p.materials.resize(2);
     for (auto &m : p.materials)
       {
@@ -64,9 +53,6 @@ namespace
       }
     p.materials[1].elastic.youngs_modulus = 4e5;
     p.material_fields.resize(2);
-    p.point_weight = 20;
-    p.gravity      = std::vector<double>(dim, 0.0);
-    p.gravity[dim - 1] = -9.81;
     return p;
   }
 

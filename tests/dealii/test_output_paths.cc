@@ -20,6 +20,7 @@
 #include <deal.II/particles/data_out.h>
 
 #include "../core/check.h"
+#include "box_scene.h"
 
 #include <algorithm>
 #include <iterator>
@@ -66,27 +67,11 @@ namespace
   template <int dim>
   Parameters scene()
   {
-    Parameters p;
-    p.dim       = dim;
-    p.lower     = std::vector<double>(dim, 0.0);
-    p.upper     = std::vector<double>(dim, 0.08);
-    p.cell_size = 0.01;
-    p.boundary.fill(BoundaryType::free);
-    BodyParameters body;
-    body.shape                = "box";
-    body.lower                = std::vector<double>(dim, 0.01);
-    body.upper                = std::vector<double>(dim, 0.05);
-    body.points_per_direction = 2;
-    body.density              = 2000;
-    body.velocity             = std::vector<double>(dim, 0.0);
-    body.initial_stress       = "none";
-    body.k0                   = 0.5;
-    p.bodies                  = {body};
-    p.body_material           = {0};
+    Parameters p      = mpm_test::box_domain<dim>(0.08, 0.01);
+    p.bodies          = {mpm_test::box_body<dim>(0.01, 0.05, 2, 2000)};
+    p.body_material   = {0};
     p.materials.resize(1);
     p.material_fields.resize(1);
-    p.point_weight = 20;
-    p.gravity      = std::vector<double>(dim, 0.0);
     return p;
   }
 
