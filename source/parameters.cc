@@ -116,7 +116,15 @@ namespace mpm
     prm.declare_entry("Fixed time step", "1e-4", Patterns::Double(0),
                       "Time step (s) when Time step = fixed; must not exceed h / c_el.");
     prm.declare_entry("Local damping", "0", Patterns::Double(0, 1),
-                      "Local (Cundall) damping D: nodal force f <- f - D |f| sign(v), 0 <= D < 1.");
+                      "Local (Cundall) damping D, 0 <= D < 1: each component of the nodal force is reduced by "
+                      "D times a magnitude against the nodal velocity, f_i <- f_i - D |.| sign(v_i) (see Local "
+                      "damping form).");
+    prm.declare_entry("Local damping form", "per component", Patterns::Selection("per component|force norm"),
+                      "The magnitude in Local damping: per component, f_i <- f_i - D |f_i| sign(v_i) (Cundall; "
+                      "a body in static equilibrium is not held by it); force norm, f_i <- f_i - D |f| sign(v_i) "
+                      "with |f| the norm of the whole nodal force, fixed components included (ep2-3De's form: a "
+                      "large force in one direction resists motion in the others like friction and can hold a "
+                      "body away from equilibrium; doc/validation-v5.md).");
     prm.declare_entry("FLIP fraction", "1", Patterns::Double(0, 1),
                       "Velocity update: 1 = pure FLIP, 0 = pure PIC, in between a blend.");
     prm.declare_entry("Gravity", zeros(dim, -9.81), point_pattern(dim),
@@ -305,6 +313,8 @@ namespace mpm
     damping = prm.get_double("Local damping");
     if (!(damping < 1))
       fail("Solver/Local damping", "must satisfy 0 <= D < 1, got " + prm.get("Local damping") + ".");
+    damping_form = prm.get("Local damping form") == "force norm" ? LocalDampingForm::force_norm
+                                                                  : LocalDampingForm::per_component;
     flip_fraction     = prm.get_double("FLIP fraction");
     gravity           = get_point(prm, "Gravity");
     gravity_ramp_time = prm.get_double("Gravity ramp time");

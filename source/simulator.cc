@@ -224,6 +224,7 @@ namespace mpm
     StepSettings<dim, double> settings;
     settings.scheme             = parameters.scheme;
     settings.damping            = parameters.damping;
+    settings.damping_form       = parameters.damping_form;
     settings.flip_fraction      = parameters.flip_fraction;
     settings.domain_update      = parameters.domain_update;
     settings.pressure_averaging = parameters.pressure_averaging;

@@ -9,6 +9,7 @@
 #pragma once
 
 #include <mpm/core/interpolation.h>
+#include <mpm/core/local_damping.h>
 #include <mpm/core/stencil_contribution.h>
 #include <mpm/core/material/material.h>
 #include <mpm/core/shape_functions.h>
@@ -43,6 +44,7 @@ namespace mpm
     UpdateScheme scheme;
     Real         gravity[dim];   // body acceleration at this step (ramp already applied)
     Real         damping;        // local damping coefficient D
+    LocalDampingForm damping_form = LocalDampingForm::per_component; // local_damping.h
     Real         flip_fraction;  // 1: pure FLIP, 0: pure PIC
     DomainUpdate domain_update;  // uGIMP or cpGIMP variants
     Real         mass_tolerance; // nodes lighter than this carry no velocity
@@ -299,7 +301,7 @@ namespace mpm
       });
     }
 
-    // Grid update: local damping f <- f - D |f| sign(v), boundary masks, explicit
+    // Grid update: local damping (local_damping.h), boundary masks, explicit
     // momentum update. Leaves v^{n+1} in velocity[], p^{n+1} in momentum[] (or zero where
     // the next stage rebuilds the momentum from the points: MUSL's remap, one pass over
     // the nodes less), and in force[] the nodal part of the blended G2P velocity,
@@ -316,6 +318,15 @@ namespace mpm
         if (!zero_cell_sums_then_is_node(g, n, n_cells))
           return;
         const Real m = g.mass[n];
+        Real       f[dim], v[dim];
+        for (int d = 0; d < dim; ++d)
+          {
+            f[d] = g.force[d][n];
+            v[d] = m > s.mass_tolerance ? g.momentum[d][n] / m : Real(0);
+          }
+        // Damping sees the whole force, the components a boundary holds fixed included
+        // (the force-norm form takes its norm).
+        apply_local_damping<dim>(f, v, s.damping, s.damping_form);
         for (int d = 0; d < dim; ++d)
           {
             const bool fixed = (g.fixed_components[n] >> d) & 1u;
@@ -324,15 +335,11 @@ namespace mpm
                 g.momentum[d][n] = g.force[d][n] = g.velocity[d][n] = Real(0);
                 continue;
               }
-            Real       f = g.force[d][n];
-            const Real v = g.momentum[d][n] / m;
-            if (v != Real(0))
-              f -= s.damping * std::fabs(f) * (v > Real(0) ? Real(1) : Real(-1));
-            const Real p_new = g.momentum[d][n] + dt * f;
+            const Real p_new = g.momentum[d][n] + dt * f[d];
             const Real v_new = p_new / m;
             g.momentum[d][n] = zero_momentum ? Real(0) : p_new;
             g.velocity[d][n] = v_new;
-            g.force[d][n]    = s.flip_fraction * (dt * (f / m)) + (Real(1) - s.flip_fraction) * v_new;
+            g.force[d][n]    = s.flip_fraction * (dt * (f[d] / m)) + (Real(1) - s.flip_fraction) * v_new;
           }
       });
     }

@@ -54,6 +54,7 @@ namespace mpm
     double       cfl;
     double       fixed_time_step;
     double       damping;
+    LocalDampingForm damping_form;
     double       flip_fraction;
     std::vector<double> gravity;
     double       gravity_ramp_time;

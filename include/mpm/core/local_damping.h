@@ -1,0 +1,46 @@
+// Local (Cundall) damping of a node's out-of-balance force, in two forms (doc/theory.md,
+// "Local damping"). Each component of the force is reduced by D times a magnitude, against
+// the direction of the node's velocity in that component:
+//   per component:  f_i <- f_i - D |f_i| sign(v_i)   (Cundall's form; the default)
+//   force norm:     f_i <- f_i - D |f|   sign(v_i)   (ep2-3De's form), |f| the norm of the
+//                   whole nodal force, the components a boundary holds fixed included.
+// The per-component form removes power only where force and motion act in the same
+// component, so a body at rest in static equilibrium (f = 0) is not held by it. The
+// force-norm form lets a large force in one component (the vertical while gravity loads,
+// or the normal reaction on a free-slip wall) oppose motion in the others, like friction:
+// it can hold a body away from equilibrium (doc/validation-v5.md).
+// Components with speed |v_i| <= threshold are not damped.
+#pragma once
+
+#include <mpm/core/config.h>
+
+#include <cmath>
+
+namespace mpm
+{
+  enum class LocalDampingForm : int
+  {
+    per_component = 0,
+    force_norm    = 1
+  };
+
+  // Applies the damping to the force f of one node, whose velocity is v, in place.
+  template <int dim, typename Real>
+  MPM_HOST_DEVICE inline void apply_local_damping(Real f[dim], const Real v[dim], const Real damping,
+                                                  const LocalDampingForm form, const Real threshold = Real(0))
+  {
+    Real norm = Real(0);
+    if (form == LocalDampingForm::force_norm)
+      {
+        for (int d = 0; d < dim; ++d)
+          norm += f[d] * f[d];
+        norm = std::sqrt(norm);
+      }
+    for (int d = 0; d < dim; ++d)
+      if (std::fabs(v[d]) > threshold)
+        {
+          const Real magnitude = form == LocalDampingForm::force_norm ? norm : std::fabs(f[d]);
+          f[d] -= damping * magnitude * (v[d] > Real(0) ? Real(1) : Real(-1));
+        }
+  }
+} // namespace mpm
