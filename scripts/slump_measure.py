@@ -83,7 +83,7 @@ def measure(start, end, threshold, bin_width, base_top, back):
     r["crest_drop"] = float(top - x1[above, dim - 1].max()) if above.any() else float(top)
     near_top = failed & (z0 > surf - bin_width)
     r["crown_x"] = float(x0[near_top, 0].min()) if near_top.any() else float("nan")
-    if dim == 3:  # the crown along the width: straight or curved
+    if dim == 3 and near_top.any():  # the crown along the width: straight or curved
         slab = np.floor((x0[:, 1] - x0[:, 1].min()) / bin_width + 1e-9).astype(int)
         crowns = [x0[near_top & (slab == k), 0].min() for k in np.unique(slab) if (near_top & (slab == k)).any()]
         r["crown_x_across_width"] = {"n_slabs": len(crowns), "min": float(np.min(crowns)),

@@ -125,6 +125,10 @@ namespace mpm
                       "with |f| the norm of the whole nodal force, fixed components included (ep2-3De's form: a "
                       "large force in one direction resists motion in the others like friction and can hold a "
                       "body away from equilibrium; doc/validation-v5.md).");
+    prm.declare_entry("Local damping threshold", "0", Patterns::Double(0),
+                      "Velocity components of a node at or below this speed (m/s) are not damped. ep2-3De uses "
+                      "1e-3 m/s; with Local damping form = force norm a threshold is needed, since a component "
+                      "at rest up to round-off is otherwise braked by D |f| in a direction that round-off picks.");
     prm.declare_entry("FLIP fraction", "1", Patterns::Double(0, 1),
                       "Velocity update: 1 = pure FLIP, 0 = pure PIC, in between a blend.");
     prm.declare_entry("Gravity", zeros(dim, -9.81), point_pattern(dim),
@@ -315,6 +319,7 @@ namespace mpm
       fail("Solver/Local damping", "must satisfy 0 <= D < 1, got " + prm.get("Local damping") + ".");
     damping_form = prm.get("Local damping form") == "force norm" ? LocalDampingForm::force_norm
                                                                   : LocalDampingForm::per_component;
+    damping_threshold = prm.get_double("Local damping threshold");
     flip_fraction     = prm.get_double("FLIP fraction");
     gravity           = get_point(prm, "Gravity");
     gravity_ramp_time = prm.get_double("Gravity ramp time");

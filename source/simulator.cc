@@ -225,6 +225,7 @@ namespace mpm
     settings.scheme             = parameters.scheme;
     settings.damping            = parameters.damping;
     settings.damping_form       = parameters.damping_form;
+    settings.damping_threshold  = parameters.damping_threshold;
     settings.flip_fraction      = parameters.flip_fraction;
     settings.domain_update      = parameters.domain_update;
     settings.pressure_averaging = parameters.pressure_averaging;

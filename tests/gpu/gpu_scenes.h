@@ -2,7 +2,8 @@
 // CPU and GPU runs of one scene execute the same host code around the same step.h.
 //   column  : tests/core/elastic_column.h (V1, shared with the CPU tests)
 //   slump   : P1/V5 slump geometry, reduced to 2 cells across (3D, GIMP, 10,024 points),
-//             elastic or Drucker-Prager, gravity ramp, local damping 0.1, free-slip walls and base
+//             elastic or Drucker-Prager, gravity ramp, local damping 0.1 (either form), free-slip walls
+//             and base
 //   collapse: V3 geometry (2D, 0.2 m x 0.1 m column against a wall), h = 5 mm, 2x2 ppc,
 //             elastic or Drucker-Prager; no-slip base, rollers on walls, gravity applied at once
 #pragma once
@@ -29,7 +30,9 @@ namespace mpm_test
   template <template <int, typename> class Target, typename Real = double>
   SceneResult slump(const int n_cells_y, mpm::HostPoints<3, Real> &points, const long n_steps,
                     const mpm::HostPoints<3, Real> *initial = nullptr, const double damping = mpm_bench::P1::damping,
-                    const bool drucker_prager = false)
+                    const bool drucker_prager = false,
+                    const mpm::LocalDampingForm damping_form = mpm::LocalDampingForm::per_component,
+                    const double damping_threshold = 0)
   {
     using namespace mpm;
     using mpm_bench::P1;
@@ -40,6 +43,8 @@ namespace mpm_test
       points = *initial; // same scene, points given (e.g. reordered)
     StepSettings<3, Real> s = mpm_bench::p1_settings<Real>();
     s.damping               = Real(damping);
+    s.damping_form          = damping_form;
+    s.damping_threshold     = Real(damping_threshold);
     const double          c = mpm_bench::p1_wave_speed();
     Target<3, Real>       target(grid, points, materials);
     auto                  gv = target.grid();

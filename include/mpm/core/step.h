@@ -45,6 +45,7 @@ namespace mpm
     Real         gravity[dim];   // body acceleration at this step (ramp already applied)
     Real         damping;        // local damping coefficient D
     LocalDampingForm damping_form = LocalDampingForm::per_component; // local_damping.h
+    Real             damping_threshold = Real(0); // nodal speeds at or below it are not damped
     Real         flip_fraction;  // 1: pure FLIP, 0: pure PIC
     DomainUpdate domain_update;  // uGIMP or cpGIMP variants
     Real         mass_tolerance; // nodes lighter than this carry no velocity
@@ -326,7 +327,7 @@ namespace mpm
           }
         // Damping sees the whole force, the components a boundary holds fixed included
         // (the force-norm form takes its norm).
-        apply_local_damping<dim>(f, v, s.damping, s.damping_form);
+        apply_local_damping<dim>(f, v, s.damping, s.damping_form, s.damping_threshold);
         for (int d = 0; d < dim; ++d)
           {
             const bool fixed = (g.fixed_components[n] >> d) & 1u;

@@ -55,6 +55,7 @@ namespace mpm
     double       fixed_time_step;
     double       damping;
     LocalDampingForm damping_form;
+    double       damping_threshold; // m/s
     double       flip_fraction;
     std::vector<double> gravity;
     double       gravity_ramp_time;
