@@ -487,31 +487,50 @@ namespace mpm
     prm.leave_subsection();
   }
 
+  namespace
+  {
+    // The two passes of a read: the first finds the dimension, the number of bodies and the
+    // material names (everything else skipped), the second declares every entry for them and
+    // rejects unknown ones. parse(prm, skip_undefined) reads the input into prm.
+    template <typename Parse>
+    Parameters read_in_two_passes(Parse &&parse)
+    {
+      ParameterHandler layout;
+      declare_layout(layout);
+      parse(layout, true);
+      const unsigned int dim = layout.get_integer("Dimension");
+      layout.enter_subsection("Material points");
+      const unsigned int n_bodies = layout.get_integer("Number of bodies");
+      layout.leave_subsection();
+      layout.enter_subsection("Materials");
+      const std::vector<std::string> names = dealii::Utilities::split_string_list(layout.get("Names"), ',');
+      layout.leave_subsection();
+
+      ParameterHandler prm;
+      Parameters::declare(prm, dim, n_bodies, names);
+      parse(prm, false);
+      Parameters parameters;
+      parameters.parse(prm);
+      return parameters;
+    }
+  } // namespace
+
   Parameters read_parameters(const std::string &filename)
   {
     {
       std::ifstream in(filename);
       AssertThrow(in, ExcMessage("Cannot open the parameter file '" + filename + "'."));
     }
-    // Pass 1: dimension, bodies and material names; everything else is skipped.
-    ParameterHandler layout;
-    declare_layout(layout);
-    layout.parse_input(filename, "", /*skip_undefined=*/true);
-    const unsigned int dim = layout.get_integer("Dimension");
-    layout.enter_subsection("Material points");
-    const unsigned int n_bodies = layout.get_integer("Number of bodies");
-    layout.leave_subsection();
-    layout.enter_subsection("Materials");
-    const std::vector<std::string> names = dealii::Utilities::split_string_list(layout.get("Names"), ',');
-    layout.leave_subsection();
+    return read_in_two_passes([&](ParameterHandler &prm, const bool skip_undefined) {
+      prm.parse_input(filename, "", skip_undefined, /*assert_mandatory_entries_are_found=*/false);
+    });
+  }
 
-    // Pass 2: every entry declared, unknown ones rejected.
-    ParameterHandler prm;
-    Parameters::declare(prm, dim, n_bodies, names);
-    prm.parse_input(filename, "", /*skip_undefined=*/false, /*assert_mandatory_entries_are_found=*/false);
-    Parameters parameters;
-    parameters.parse(prm);
-    return parameters;
+  Parameters parameters_from_string(const std::string &text)
+  {
+    return read_in_two_passes([&](ParameterHandler &prm, const bool skip_undefined) {
+      prm.parse_input_from_string(text, "", skip_undefined);
+    });
   }
 
   void print_parameters(std::ostream &out, const unsigned int dim, const std::string &style)

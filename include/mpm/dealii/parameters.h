@@ -105,6 +105,8 @@ namespace mpm
   // of bodies and the material names, the second declares and reads everything,
   // rejecting unknown entries. Throws with a message naming the offending entry.
   Parameters read_parameters(const std::string &filename);
+  // The same from the text of a parameter file (a program that writes its scene in C++).
+  Parameters parameters_from_string(const std::string &text);
 
   // Prints every entry with its default and documentation (for --print-parameters).
   void print_parameters(std::ostream &out, unsigned int dim, const std::string &style);

@@ -1,10 +1,24 @@
-// A dealii-mpm run: set up the grid and the points, then step until the end time,
-// writing output and the time history. Reads top to bottom as the algorithm.
+// A dealii-mpm run, driven by the executable or by a user's program:
+//
+//   mpm::Parameters parameters = mpm::read_parameters("scene.prm");  // or filled in C++
+//   mpm::Simulator<2> simulator(parameters, MPI_COMM_WORLD);
+//   simulator.setup();                       // grid, points, engine; the t = 0 output
+//   while (!simulator.finished())
+//     simulator.advance();                   // one explicit step, with the outputs it owes
+//   simulator.finish();                      // last output, the run's summary
+//
+// run() does the same, and on one MPI rank starts stepping while deal.II builds its grid and
+// ParticleHandler on a thread (that thread calls MPI, so between the calls of a program
+// that steps the run itself, setup() finishes the grid first and no thread is left running).
+// The points can be read and changed between steps (points(), set_points()).
 #pragma once
 
+#include <mpm/core/host_storage.h>
 #include <mpm/dealii/parameters.h>
 
 #include <mpi.h>
+
+#include <memory>
 
 namespace mpm
 {
@@ -13,13 +27,41 @@ namespace mpm
   {
   public:
     Simulator(const Parameters &parameters, MPI_Comm communicator);
+    // Waits for output still being written; prints the timing summary.
+    ~Simulator();
+
+    // Builds the background grid, the material points and the engine (Backend), and writes
+    // the t = 0 output and history row. Throws naming the parameter on bad input.
+    void setup();
+    // One explicit step of the scheme, then the history row and output due after it.
+    // Returns the time step taken. Throws if the run has become unstable.
+    double advance();
+    // True once End time (or Maximum number of steps) is reached.
+    bool finished() const;
+    // Writes the last output (if not yet written at this time), waits for the output files
+    // and prints the run's summary.
+    void finish();
+    // setup(), advance() until finished(), finish().
     void run();
 
+    double time() const;
+    long   step() const;
+    const Parameters &parameters() const;
+
+    // The material points as the engine holds them now, in the engine's order; points that
+    // have left the grid are included with material < 0. Every field of the core's point
+    // arrays (HostPoints): position, velocity, mass, volume, stress, strain, F, ...
+    HostPoints<dim, double> points() const;
+    // Replaces the points' values: the same points in the same order (as points() gave
+    // them), any field changed. One MPI rank for now.
+    void set_points(const HostPoints<dim, double> &points);
+
   private:
-    const Parameters parameters;
-    MPI_Comm         communicator;
+    struct State;
+    void setup(bool grid_beside_first_steps);
+    std::unique_ptr<State> state;
   };
 
-  // Runs the simulator of the parameter file's dimension.
+  // Runs the simulator of the parameter file's dimension (the executable).
   void run_simulation(const Parameters &parameters, MPI_Comm communicator);
 } // namespace mpm
