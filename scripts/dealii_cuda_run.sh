@@ -16,6 +16,8 @@ WORK=${WORK:-/tmp/dealii-cuda-run}
 OUT=$WORK/results
 mkdir -p "$OUT" "$WORK" "$FINAL"
 BIN=$(cd "$BIN" && pwd)
+# dealii-mpm links libdealii-mpm.so: copied beside it into $BIN (cp -P build-cuda/libdealii-mpm.so* $BIN).
+export LD_LIBRARY_PATH="$BIN${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
 export OUT FINAL
 export OMPI_MCA_ess_singleton_isolated=1 # singleton without orted
 # libdeal.ii itself travels beside the binaries when the runtime bundle lacks it

@@ -8,6 +8,8 @@
 set -u -o pipefail
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
 BIN=$(cd "${BIN:-$ROOT/build-cuda/dev}" && pwd)
+# dealii-mpm links libdealii-mpm.so: copied beside it into $BIN (cp -P build-cuda/libdealii-mpm.so* $BIN).
+export LD_LIBRARY_PATH="$BIN${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
 WORK=${WORK:-/tmp/p2-variants}
 mkdir -p "$WORK"
 export OMPI_MCA_ess_singleton_isolated=1

@@ -39,6 +39,19 @@ namespace mpm
       return t;
     }
 
+    // Restores a stream's precision, which the summaries change, when it goes out of scope:
+    // a program may run several simulations and print on the same stream.
+    struct KeepPrecision
+    {
+      explicit KeepPrecision(std::ostream &stream)
+        : stream(stream)
+        , precision(stream.precision())
+      {}
+      ~KeepPrecision() { stream.precision(precision); }
+      std::ostream         &stream;
+      const std::streamsize precision;
+    };
+
     // Largest elastic wave speed over the bodies, sqrt((K + 4G/3) / rho).
     double elastic_wave_speed(const Parameters &p)
     {
@@ -449,7 +462,8 @@ namespace mpm
     if (parameters.progress_interval > 0 &&
         std::chrono::duration<double>(now - s.last_progress).count() >= parameters.progress_interval)
       {
-        const double elapsed = std::chrono::duration<double>(now - s.wall_start).count();
+        const KeepPrecision keep(std::cout);
+        const double        elapsed = std::chrono::duration<double>(now - s.wall_start).count();
         const double eta     = elapsed / s.time * (end - s.time);
         s.pcout << "  t = " << std::setw(10) << s.time << " s  step " << s.step << "  dt " << dt << "  "
                 << std::setprecision(4) << s.step / elapsed << " steps/s  ETA " << eta << " s" << std::endl;
@@ -482,6 +496,7 @@ namespace mpm
       s.output->finish(); // the last files are complete
     }
 
+    const KeepPrecision keep(std::cout);
     const double wall  = std::chrono::duration<double>(std::chrono::steady_clock::now() - s.wall_start).count();
     const double n_now = static_cast<double>(s.n_points_initial - s.n_removed);
     s.pcout << "dealii-mpm: done, t = " << s.time << " s after " << s.step << " steps in " << wall << " s wall ("
