@@ -241,11 +241,18 @@ namespace mpm
                 properties[Layout::velocity + d]                   = points.velocity[d][i];
                 properties[Layout::domain_half_length + d]         = points.domain_half_length[d][i];
                 properties[Layout::initial_domain_half_length + d] = points.initial_domain_half_length[d][i];
-                properties[Layout::deformation_gradient + d * dim + d] = 1.0;
                 properties[Layout::initial_position + d]           = x[d];
               }
+            // F, strain and plastic strain as given (I and zeros for the prm's bodies; a
+            // state handed over keeps its own).
+            for (int c = 0; c < dim * dim; ++c)
+              properties[Layout::deformation_gradient + c] = points.deformation_gradient[c][i];
             for (int c = 0; c < n_voigt; ++c)
-              properties[Layout::stress + c] = points.stress[c][i];
+              {
+                properties[Layout::stress + c] = points.stress[c][i];
+                properties[Layout::strain + c] = points.strain[c][i];
+              }
+            properties[Layout::plastic_strain] = points.plastic_strain[i];
             properties[Layout::material]       = points.material[i];
             properties[Layout::material_field] = points.material_field[i];
 
@@ -298,7 +305,7 @@ namespace mpm
       order[start[cell[g]]++] = g;
 
     p.resize(0);
-    p.resize(n); // deformation gradient I, as insert() sets it
+    p.resize(n);
     labels.id.resize(n);
     for (int d = 0; d < dim; ++d)
       labels.initial_position[d].resize(n);
@@ -316,16 +323,18 @@ namespace mpm
             p.domain_half_length[d][i]         = b.domain_half_length[d][k];
             p.initial_domain_half_length[d][i] = b.initial_domain_half_length[d][k];
           }
-        // What insert() takes from a body; strain and plastic strain start at zero.
+        // What insert() takes from a body.
         for (int c = 0; c < n_voigt; ++c)
           {
             p.stress[c][i] = b.stress[c][k];
-            p.strain[c][i] = 0;
+            p.strain[c][i] = b.strain[c][k];
           }
+        for (int c = 0; c < dim * dim; ++c)
+          p.deformation_gradient[c][i] = b.deformation_gradient[c][k];
         p.mass[i]           = b.mass[k];
         p.volume[i]         = b.volume[k];
         p.initial_volume[i] = b.initial_volume[k];
-        p.plastic_strain[i] = 0;
+        p.plastic_strain[i] = b.plastic_strain[k];
         p.material_field[i] = b.material_field[k];
         p.material[i]       = b.material[k];
       }

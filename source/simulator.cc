@@ -221,20 +221,98 @@ namespace mpm
   template <int dim>
   Simulator<dim>::~Simulator() = default;
 
+  namespace
+  {
+    // The elastic wave speed of points given to setup(): the largest over the points of
+    // sqrt(M / rho), rho = mass / volume of the point.
+    template <int dim>
+    double elastic_wave_speed(const std::vector<GeneratedBody<dim>> &bodies, const Parameters &p)
+    {
+      double c = 0;
+      for (const GeneratedBody<dim> &body : bodies)
+        for (int i = 0; i < body.points.size(); ++i)
+          c = std::max(c, std::sqrt(p.materials[body.points.material[i]].elastic.p_wave_modulus() *
+                                    body.points.volume[i] / body.points.mass[i]));
+      return c;
+    }
+
+    // Points given to setup(): inside the grid, a material of the prm, a positive mass and volume.
+    template <int dim>
+    void check_given_points(const std::vector<GeneratedBody<dim>> &bodies, const Parameters &p)
+    {
+      long n = 0;
+      for (const GeneratedBody<dim> &body : bodies)
+        for (int i = 0; i < body.points.size(); ++i, ++n)
+          {
+            std::string where = "point " + std::to_string(n) + " at (";
+            bool        inside = true;
+            for (int d = 0; d < dim; ++d)
+              {
+                const double x = body.points.position[d][i];
+                where += (d ? ", " : "") + dealii::Utilities::to_string(x);
+                inside = inside && x >= p.lower[d] && x <= p.upper[d];
+              }
+            where += ")";
+            AssertThrow(inside, dealii::ExcMessage("The material points handed over: " + where +
+                                                   " lies outside the MPM grid (Grid/Lower corner, Grid/Upper "
+                                                   "corner); make the grid enclose the body and its run-out."));
+            const int m = body.points.material[i];
+            AssertThrow(m >= 0 && m < static_cast<int>(p.materials.size()),
+                        dealii::ExcMessage("The material points handed over: " + where + " has material index " +
+                                           std::to_string(m) + ", but Materials/Names declares " +
+                                           std::to_string(p.materials.size()) + " material(s), indices 0 to " +
+                                           std::to_string(p.materials.size() - 1) + "."));
+            AssertThrow(body.points.mass[i] > 0 && body.points.volume[i] > 0,
+                        dealii::ExcMessage("The material points handed over: " + where +
+                                           " has a mass or volume that is not positive."));
+            AssertThrow(p.materials[m].field_parameter == FieldParameter::none,
+                        dealii::ExcMessage("The material points handed over: material '" + p.material_names[m] +
+                                           "' has a random field (Material " + p.material_names[m] +
+                                           "/Random field), which points handed over do not carry yet; set its "
+                                           "Parameter to none."));
+          }
+      AssertThrow(n > 0, dealii::ExcMessage("The material points handed over: there are none."));
+    }
+  } // namespace
+
   template <int dim>
   void Simulator<dim>::setup()
   {
-    setup(false);
+    setup(false, nullptr);
   }
 
   template <int dim>
-  void Simulator<dim>::setup(const bool grid_beside_first_steps)
+  void Simulator<dim>::setup(std::vector<GeneratedBody<dim>> bodies)
+  {
+    setup(false, &bodies);
+  }
+
+  template <int dim>
+  void Simulator<dim>::setup(const bool grid_beside_first_steps, std::vector<GeneratedBody<dim>> *given_bodies)
   {
     State            &s          = *state;
     const Parameters &parameters = s.parameters;
     AssertThrow(!s.set_up, dealii::ExcMessage("Simulator::setup() was called twice."));
-    s.c_el = elastic_wave_speed(parameters);
     s.h    = parameters.cell_size;
+    if (given_bodies != nullptr)
+      {
+        check_given_points(*given_bodies, parameters);
+        // GIMP's particle domains stay within half a cell, and inside the grid: a domain that
+        // reached beyond the grid's face would lose the weight of the nodes beyond it.
+        for (GeneratedBody<dim> &body : *given_bodies)
+          for (int d = 0; d < dim; ++d)
+            for (int i = 0; i < body.points.size(); ++i)
+              {
+                const double x     = body.points.position[d][i];
+                const double limit = std::min({0.5 * s.h, x - parameters.lower[d], parameters.upper[d] - x});
+                const double scale = std::min(1.0, limit / body.points.domain_half_length[d][i]);
+                body.points.domain_half_length[d][i] *= scale;
+                body.points.initial_domain_half_length[d][i] *= scale;
+              }
+        s.c_el = elastic_wave_speed(*given_bodies, parameters);
+      }
+    else
+      s.c_el = elastic_wave_speed(parameters);
     if (!parameters.adaptive_time_step)
       AssertThrow(parameters.fixed_time_step * s.c_el <= s.h,
                   dealii::ExcMessage("Parameter 'Solver/Fixed time step': " +
@@ -248,8 +326,16 @@ namespace mpm
     std::future<void> cuda_ready;
     if (parameters.backend == "cuda")
       cuda_ready = start_cuda_initialisation();
-    std::shared_future<std::vector<GeneratedBody<dim>>> generation =
-      std::async(std::launch::async, [&parameters]() { return generate_bodies<dim>(parameters); }).share();
+    std::shared_future<std::vector<GeneratedBody<dim>>> generation;
+    if (given_bodies != nullptr)
+      {
+        std::promise<std::vector<GeneratedBody<dim>>> given;
+        given.set_value(std::move(*given_bodies));
+        generation = given.get_future().share();
+      }
+    else
+      generation =
+        std::async(std::launch::async, [&parameters]() { return generate_bodies<dim>(parameters); }).share();
     s.output = std::make_unique<OutputWriter<dim>>(parameters, s.communicator); // MPI: before the grid thread
     // Before plasticity start time every model behaves elastically.
     s.materials = parameters.materials;
@@ -528,7 +614,7 @@ namespace mpm
   template <int dim>
   void Simulator<dim>::run()
   {
-    setup(true);
+    setup(true, nullptr);
     while (!finished())
       advance();
     finish();

@@ -14,11 +14,13 @@
 #pragma once
 
 #include <mpm/core/host_storage.h>
+#include <mpm/dealii/material_points.h>
 #include <mpm/dealii/parameters.h>
 
 #include <mpi.h>
 
 #include <memory>
+#include <vector>
 
 namespace mpm
 {
@@ -33,6 +35,11 @@ namespace mpm
     // Builds the background grid, the material points and the engine (Backend), and writes
     // the t = 0 output and history row. Throws naming the parameter on bad input.
     void setup();
+    // The same with the points of `bodies` instead of the prm's bodies (Material points): a
+    // state handed over from elsewhere, e.g. an FEM analysis (fem_handover.h). Every point
+    // must lie inside the grid and name one of the prm's materials (by index, Materials/Names
+    // order); the elastic wave speed of the time step comes from the points' own density.
+    void setup(std::vector<GeneratedBody<dim>> bodies);
     // One explicit step of the scheme, then the history row and output due after it.
     // Returns the time step taken. Throws if the run has become unstable.
     double advance();
@@ -58,7 +65,7 @@ namespace mpm
 
   private:
     struct State;
-    void setup(bool grid_beside_first_steps);
+    void setup(bool grid_beside_first_steps, std::vector<GeneratedBody<dim>> *given_bodies);
     std::unique_ptr<State> state;
   };
 

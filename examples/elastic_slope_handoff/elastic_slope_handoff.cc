@@ -1,0 +1,253 @@
+// elastic_slope_handoff: a user's own deal.II program solves the gravity loading of a slope with
+// the finite element method, then hands its state over to dealii-mpm and lets the MPM carry on.
+//
+// The story. Before asking how far a slope runs out, an engineer computes its state under its own
+// weight: the displacement and the stresses of the gravity loading. That is a static problem, which
+// an FEM solves in a moment, where an explicit MPM would spend seconds of simulated time (ep2-3De
+// spends 8 s of its slump run on it). Here the FEM state is handed over to the MPM, one material
+// point per quadrature point (placement (a) of doc/library.md), and the MPM steps on. Since the
+// FEM state is in equilibrium, the MPM must find the slope at rest: no damping, gravity at once,
+// twenty elastic wave transits, and the largest point speed and stress change measured in the units
+// of the problem, sqrt(g H) and rho g H.
+//
+// The parts, top to bottom:
+//   1. the slope: a mesh of a box, its top bent into the slope's profile; material_id 0;
+//   2. the FEM: linear elasticity (plane strain) under gravity with FE_Q(2)^2, rollers on the sides,
+//      a fixed base; its own assembly, CG with Trilinos' algebraic multigrid;
+//   3. the quadrature-point history: the stress of each Gauss point, in deal.II's CellDataStorage;
+//   4. the MPM scene from prm text: the same material, a grid around the slope, the same boundaries;
+//   5. the hand-over and the MPM run, stepped by this program;
+//   6. the check: how far the MPM moves the handed-over state.
+#include <mpm/dealii/fem_handover.h>
+#include <mpm/dealii/parameters.h>
+#include <mpm/dealii/simulator.h>
+
+#include <deal.II/base/function.h>
+#include <deal.II/base/mpi.h>
+#include <deal.II/base/quadrature_lib.h>
+#include <deal.II/base/quadrature_point_data.h>
+#include <deal.II/dofs/dof_handler.h>
+#include <deal.II/dofs/dof_tools.h>
+#include <deal.II/fe/fe_q.h>
+#include <deal.II/fe/fe_system.h>
+#include <deal.II/fe/fe_values.h>
+#include <deal.II/grid/grid_generator.h>
+#include <deal.II/grid/grid_tools.h>
+#include <deal.II/grid/tria.h>
+#include <deal.II/lac/affine_constraints.h>
+#include <deal.II/lac/dynamic_sparsity_pattern.h>
+#include <deal.II/lac/solver_cg.h>
+#include <deal.II/lac/trilinos_precondition.h>
+#include <deal.II/lac/trilinos_sparse_matrix.h>
+#include <deal.II/lac/trilinos_vector.h>
+#include <deal.II/numerics/vector_tools.h>
+
+#include <algorithm>
+#include <cmath>
+#include <iostream>
+
+using namespace dealii;
+
+namespace
+{
+  constexpr int dim = 2;
+  // Slope: 30 m long, 10 m high behind the crest (x < 10 m), falling at 1:2 (26.6 deg) to 5 m at
+  // x = 20 m, then level; dry soil, rho = 2000 kg/m^3, E = 20 MPa, nu = 0.3, g = 9.81 m/s^2.
+  constexpr double length = 30, H = 10, rho = 2000, E = 20e6, nu = 0.3, g = 9.81;
+
+  double surface(const double x)
+  {
+    return x < 10 ? H : (x < 20 ? H - 0.5 * (x - 10) : H / 2);
+  }
+
+  // The quadrature-point history of the FEM: it derives from mpm::QuadraturePointState (stress in
+  // Voigt order, plastic strain), which is what the hand-over takes.
+  struct PointHistory : mpm::QuadraturePointState
+  {};
+} // namespace
+
+int main(int argc, char **argv)
+{
+  Utilities::MPI::MPI_InitFinalize mpi(argc, argv, 1);
+  try
+    {
+      // 1. The slope: 60 x 20 cells of a box, each point's height scaled to the slope's profile.
+      Triangulation<dim> triangulation;
+      GridGenerator::subdivided_hyper_rectangle(triangulation, {60, 20}, Point<dim>(0, 0), Point<dim>(length, H),
+                                                /*colorize=*/true); // ids 0, 1: x = 0, 30; 2, 3: y = 0, H
+      GridTools::transform([](const Point<dim> &p) { return Point<dim>(p[0], p[1] * surface(p[0]) / H); },
+                           triangulation);
+      for (const auto &cell : triangulation.active_cell_iterators())
+        cell->set_material_id(0); // colorize numbered the cells too: one soil here
+
+      // 2. Linear elasticity under gravity (plane strain), Q2 displacements.
+      const FESystem<dim> fe(FE_Q<dim>(2), dim);
+      DoFHandler<dim>     dof_handler(triangulation);
+      dof_handler.distribute_dofs(fe);
+      const FEValuesExtractors::Vector displacement(0);
+
+      AffineConstraints<double> constraints;
+      VectorTools::interpolate_boundary_values(dof_handler, 2, Functions::ZeroFunction<dim>(dim), constraints);
+      for (const types::boundary_id side : {0, 1}) // rollers: u_x = 0
+        VectorTools::interpolate_boundary_values(dof_handler, side, Functions::ZeroFunction<dim>(dim), constraints,
+                                                 fe.component_mask(FEValuesExtractors::Scalar(0)));
+      constraints.close();
+
+      const IndexSet         owned = dof_handler.locally_owned_dofs();
+      DynamicSparsityPattern dsp(dof_handler.n_dofs());
+      DoFTools::make_sparsity_pattern(dof_handler, dsp, constraints, false);
+      TrilinosWrappers::SparseMatrix matrix;
+      matrix.reinit(owned, owned, dsp, MPI_COMM_WORLD);
+      TrilinosWrappers::MPI::Vector rhs(owned, MPI_COMM_WORLD), solution(owned, MPI_COMM_WORLD);
+
+      const double    lambda = E * nu / ((1 + nu) * (1 - 2 * nu)), mu = E / (2 * (1 + nu));
+      const QGauss<dim> quadrature(3);
+      FEValues<dim>     fe_values(fe, quadrature, update_values | update_gradients | update_JxW_values);
+      const unsigned int n_dofs = fe.n_dofs_per_cell(), n_q = quadrature.size();
+      FullMatrix<double> cell_matrix(n_dofs, n_dofs);
+      Vector<double>     cell_rhs(n_dofs);
+      std::vector<types::global_dof_index> dofs(n_dofs);
+      Tensor<1, dim>                       gravity;
+      gravity[1] = -g;
+      for (const auto &cell : dof_handler.active_cell_iterators())
+        {
+          fe_values.reinit(cell);
+          cell_matrix = 0;
+          cell_rhs    = 0;
+          for (unsigned int q = 0; q < n_q; ++q)
+            for (unsigned int i = 0; i < n_dofs; ++i)
+              {
+                const SymmetricTensor<2, dim> eps_i = fe_values[displacement].symmetric_gradient(i, q);
+                for (unsigned int j = 0; j < n_dofs; ++j)
+                  {
+                    const SymmetricTensor<2, dim> eps_j = fe_values[displacement].symmetric_gradient(j, q);
+                    cell_matrix(i, j) += (lambda * trace(eps_i) * trace(eps_j) + 2 * mu * (eps_i * eps_j)) *
+                                         fe_values.JxW(q);
+                  }
+                cell_rhs(i) += rho * (gravity * fe_values[displacement].value(i, q)) * fe_values.JxW(q);
+              }
+          cell->get_dof_indices(dofs);
+          constraints.distribute_local_to_global(cell_matrix, cell_rhs, dofs, matrix, rhs);
+        }
+      matrix.compress(VectorOperation::add);
+      rhs.compress(VectorOperation::add);
+
+      TrilinosWrappers::PreconditionAMG                 amg;
+      TrilinosWrappers::PreconditionAMG::AdditionalData amg_data;
+      amg_data.elliptic              = true;
+      amg_data.higher_order_elements = true;
+      DoFTools::extract_constant_modes(dof_handler, ComponentMask(dim, true), amg_data.constant_modes);
+      amg.initialize(matrix, amg_data);
+      SolverControl                           control(1000, 1e-12 * rhs.l2_norm());
+      SolverCG<TrilinosWrappers::MPI::Vector> cg(control);
+      cg.solve(matrix, solution, rhs, amg);
+      constraints.distribute(solution);
+      std::cout << "FEM: " << triangulation.n_active_cells() << " cells, " << dof_handler.n_dofs()
+                << " DoFs, CG + AMG converged in " << control.last_step() << " iterations" << std::endl;
+
+      // 3. The stress of each quadrature point, sigma = lambda tr(eps) I + 2 mu eps, with the
+      // plane-strain sigma_zz = lambda tr(eps), kept in deal.II's quadrature-point storage.
+      CellDataStorage<typename Triangulation<dim>::cell_iterator, PointHistory> history;
+      history.initialize(triangulation.begin_active(), triangulation.end(), n_q);
+      std::vector<SymmetricTensor<2, dim>> strain(n_q);
+      for (const auto &cell : dof_handler.active_cell_iterators())
+        {
+          fe_values.reinit(cell);
+          fe_values[displacement].get_function_symmetric_gradients(solution, strain);
+          const auto points = history.get_data(cell);
+          for (unsigned int q = 0; q < n_q; ++q)
+            {
+              const double tr = trace(strain[q]);
+              points[q]->stress[0] = lambda * tr + 2 * mu * strain[q][0][0]; // xx
+              points[q]->stress[1] = lambda * tr + 2 * mu * strain[q][1][1]; // yy
+              points[q]->stress[2] = lambda * tr;                            // zz (plane strain)
+              points[q]->stress[3] = 2 * mu * strain[q][0][1];               // xy
+            }
+        }
+
+      // 4. The MPM scene: the same soil, a grid of 0.5 m cells around the slope with 5 m of room
+      // above it, the FEM's boundaries (rollers on the sides, a fixed base), no damping, gravity at
+      // once. Its bodies section is not used: the points come from the FEM.
+      mpm::Parameters parameters = mpm::parameters_from_string(R"(
+        set Dimension = 2
+        subsection Grid
+          set Lower corner = 0, 0
+          set Upper corner = 30, 15
+          set Cell size    = 0.5
+        end
+        subsection Boundary conditions
+          set x min = free-slip
+          set x max = free-slip
+          set y min = no-slip
+          set y max = free
+        end
+        subsection Solver
+          set Shape function     = GIMP
+          set GIMP domain update = det F
+          set Local damping      = 0
+          set Gravity            = 0, -9.81
+        end
+        subsection Materials
+          set Names = soil
+        end
+        subsection Material soil
+          set Model = linear elastic
+          subsection linear elastic
+            set Young's modulus = 20e6
+            set Poisson's ratio = 0.3
+          end
+        end
+        subsection Output
+          set Directory       = output-elastic-slope-handoff
+          set Output interval = 0
+        end
+      )");
+      const double M = E * (1 - nu) / ((1 + nu) * (1 - 2 * nu)); // P-wave modulus
+      parameters.end_time = 20 * H / std::sqrt(M / rho);           // twenty elastic wave transits
+
+      // 5. The hand-over: one point per Gauss point, material_id 0 -> MPM material 0 ("soil").
+      const std::map<types::material_id, mpm::HandoverMaterial> materials{{0, {0, rho}}};
+      mpm::GeneratedBody<dim> body =
+        mpm::points_at_quadrature_points(dof_handler, solution, quadrature, history, materials);
+      mpm::Simulator<dim> simulator(parameters, MPI_COMM_WORLD);
+      simulator.setup({body});
+      const mpm::HostPoints<dim, double> start = simulator.points();
+      double fastest = 0;
+      while (!simulator.finished())
+        {
+          simulator.advance();
+          const mpm::HostPoints<dim, double> now = simulator.points();
+          for (int i = 0; i < now.size(); ++i)
+            fastest = std::max(fastest, std::hypot(now.velocity[0][i], now.velocity[1][i]));
+        }
+      simulator.finish();
+
+      // 6. At rest? The largest point speed against sqrt(g H), the largest stress change against
+      // rho g H.
+      const mpm::HostPoints<dim, double> end = simulator.points();
+      double change = 0;
+      for (int i = 0; i < end.size(); ++i)
+        for (int c = 0; c < mpm::n_voigt; ++c)
+          change = std::max(change, std::abs(end.stress[c][i] - start.stress[c][i]));
+      const double speed_ratio = fastest / std::sqrt(g * H), stress_ratio = change / (rho * g * H);
+      std::cout << "MPM: " << start.size() << " points handed over, " << simulator.step() << " steps to t = "
+                << simulator.time() << " s (20 wave transits), no damping:\n"
+                << "  largest point speed / sqrt(g H)   = " << speed_ratio << "\n"
+                << "  largest stress change / (rho g H) = " << stress_ratio << std::endl;
+      // What the MPM's own discretisation of this state gives: 3.1e-3 and 3.1e-2 here, falling
+      // about linearly with the spacing of the quadrature points (doc/library.md), so not yet the
+      // 1e-3 a hand-over should reach. The bounds catch a broken hand-over: a slope whose points
+      // lost their stress falls under gravity (speeds of order sqrt(g H), stress changes of order
+      // rho g H).
+      const bool at_rest = speed_ratio < 1e-2 && stress_ratio < 1e-1;
+      std::cout << (at_rest ? "the slope handed over stays at rest (to the bounds above)" :
+                              "FAILED: the slope handed over moves")
+                << std::endl;
+      return at_rest ? 0 : 1;
+    }
+  catch (const std::exception &e)
+    {
+      std::cerr << "elastic_slope_handoff: " << e.what() << std::endl;
+      return 1;
+    }
+}
