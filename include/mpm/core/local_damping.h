@@ -24,10 +24,9 @@ namespace mpm
     force_norm    = 1
   };
 
-  // Applies the damping to the force f of one node, whose velocity is v, in place.
+  // The norm |f| of a node's whole force, for the force-norm form (0 for the other: unused).
   template <int dim, typename Real>
-  MPM_HOST_DEVICE inline void apply_local_damping(Real f[dim], const Real v[dim], const Real damping,
-                                                  const LocalDampingForm form, const Real threshold = Real(0))
+  MPM_HOST_DEVICE inline Real local_damping_norm(const Real f[dim], const LocalDampingForm form)
   {
     Real norm = Real(0);
     if (form == LocalDampingForm::force_norm)
@@ -36,11 +35,28 @@ namespace mpm
           norm += f[d] * f[d];
         norm = std::sqrt(norm);
       }
+    return norm;
+  }
+
+  // One damped component: f is the component, v the node's velocity in it, norm from
+  // local_damping_norm. The grid update calls it component by component.
+  template <typename Real>
+  MPM_HOST_DEVICE inline Real damped_force_component(const Real f, const Real v, const Real norm, const Real damping,
+                                                     const LocalDampingForm form, const Real threshold)
+  {
+    if (!(std::fabs(v) > threshold))
+      return f;
+    const Real magnitude = form == LocalDampingForm::force_norm ? norm : std::fabs(f);
+    return f - damping * magnitude * (v > Real(0) ? Real(1) : Real(-1));
+  }
+
+  // The same for a whole node, in place: f its force, v its velocity.
+  template <int dim, typename Real>
+  MPM_HOST_DEVICE inline void apply_local_damping(Real f[dim], const Real v[dim], const Real damping,
+                                                  const LocalDampingForm form, const Real threshold = Real(0))
+  {
+    const Real norm = local_damping_norm<dim>(f, form);
     for (int d = 0; d < dim; ++d)
-      if (std::fabs(v[d]) > threshold)
-        {
-          const Real magnitude = form == LocalDampingForm::force_norm ? norm : std::fabs(f[d]);
-          f[d] -= damping * magnitude * (v[d] > Real(0) ? Real(1) : Real(-1));
-        }
+      f[d] = damped_force_component(f[d], v[d], norm, damping, form, threshold);
   }
 } // namespace mpm

@@ -319,15 +319,16 @@ namespace mpm
         if (!zero_cell_sums_then_is_node(g, n, n_cells))
           return;
         const Real m = g.mass[n];
-        Real       f[dim], v[dim];
-        for (int d = 0; d < dim; ++d)
+        // The force-norm form sees the whole force, the components a boundary holds fixed
+        // included (read only for that form: the default reads nothing more).
+        Real norm = Real(0);
+        if (s.damping_form == LocalDampingForm::force_norm)
           {
-            f[d] = g.force[d][n];
-            v[d] = m > s.mass_tolerance ? g.momentum[d][n] / m : Real(0);
+            Real f[dim];
+            for (int d = 0; d < dim; ++d)
+              f[d] = g.force[d][n];
+            norm = local_damping_norm<dim>(f, s.damping_form);
           }
-        // Damping sees the whole force, the components a boundary holds fixed included
-        // (the force-norm form takes its norm).
-        apply_local_damping<dim>(f, v, s.damping, s.damping_form, s.damping_threshold);
         for (int d = 0; d < dim; ++d)
           {
             const bool fixed = (g.fixed_components[n] >> d) & 1u;
@@ -336,11 +337,14 @@ namespace mpm
                 g.momentum[d][n] = g.force[d][n] = g.velocity[d][n] = Real(0);
                 continue;
               }
-            const Real p_new = g.momentum[d][n] + dt * f[d];
+            const Real v     = g.momentum[d][n] / m;
+            const Real f     = damped_force_component(g.force[d][n], v, norm, s.damping, s.damping_form,
+                                                      s.damping_threshold);
+            const Real p_new = g.momentum[d][n] + dt * f;
             const Real v_new = p_new / m;
             g.momentum[d][n] = zero_momentum ? Real(0) : p_new;
             g.velocity[d][n] = v_new;
-            g.force[d][n]    = s.flip_fraction * (dt * (f[d] / m)) + (Real(1) - s.flip_fraction) * v_new;
+            g.force[d][n]    = s.flip_fraction * (dt * (f / m)) + (Real(1) - s.flip_fraction) * v_new;
           }
       });
     }
