@@ -10,6 +10,7 @@
 #include <deal.II/base/mpi.h>
 #include <deal.II/base/timer.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <future>
@@ -236,6 +237,63 @@ namespace mpm
       return c;
     }
 
+    // Points handed over on several ranks come from each rank's own FEM cells. Every rank
+    // needs all of them (it keeps those in its MPM cells, as with the prm's bodies, which
+    // every rank generates whole), in one order on every rank: rank by rank.
+    template <int dim>
+    std::vector<GeneratedBody<dim>> gather_bodies(const std::vector<GeneratedBody<dim>> &local, MPI_Comm comm)
+    {
+      std::vector<double> packed; // per body: its number of points, then every array of HostPoints
+      for (const GeneratedBody<dim> &body : local)
+        {
+          packed.push_back(body.points.size());
+          for_each_point_array<dim>(body.points, body.points,
+                                    [&](const auto &array, const auto &) { packed.insert(packed.end(), array.begin(), array.end()); });
+        }
+      std::vector<GeneratedBody<dim>> all;
+      for (const std::vector<double> &from_rank : dealii::Utilities::MPI::all_gather(comm, packed))
+        for (std::size_t at = 0; at < from_rank.size();)
+          {
+            GeneratedBody<dim> body;
+            body.points.resize(static_cast<int>(from_rank[at++]));
+            for_each_point_array<dim>(body.points, body.points, [&](auto &array, auto &) {
+              using T = typename std::decay_t<decltype(array)>::value_type;
+              for (auto &value : array)
+                value = static_cast<T>(from_rank[at++]);
+            });
+            all.push_back(std::move(body));
+          }
+      return all;
+    }
+
+    // The points handed over as one body, ordered by position (lexicographically, x first):
+    // their ids (the order of generation) then do not depend on how the FEM mesh was
+    // distributed over the ranks.
+    template <int dim>
+    std::vector<GeneratedBody<dim>> in_canonical_order(const std::vector<GeneratedBody<dim>> &bodies)
+    {
+      std::vector<std::pair<int, int>> source; // (body, point)
+      for (unsigned int b = 0; b < bodies.size(); ++b)
+        for (int i = 0; i < bodies[b].points.size(); ++i)
+          source.emplace_back(b, i);
+      auto position = [&](const std::pair<int, int> &s, const int d) {
+        return bodies[s.first].points.position[d][s.second];
+      };
+      std::stable_sort(source.begin(), source.end(), [&](const auto &a, const auto &b) {
+        for (int d = 0; d < dim; ++d)
+          if (position(a, d) != position(b, d))
+            return position(a, d) < position(b, d);
+        return false;
+      });
+      std::vector<GeneratedBody<dim>> one(1);
+      HostPoints<dim, double>        &to = one[0].points;
+      to.resize(static_cast<int>(source.size()));
+      for (std::size_t k = 0; k < source.size(); ++k)
+        for_each_point_array<dim>(to, bodies[source[k].first].points,
+                                  [&](auto &destination, const auto &origin) { destination[k] = origin[source[k].second]; });
+      return one;
+    }
+
     // Points given to setup(): inside the grid, a material of the prm, a positive mass and volume.
     template <int dim>
     void check_given_points(const std::vector<GeneratedBody<dim>> &bodies, const Parameters &p)
@@ -296,6 +354,9 @@ namespace mpm
     s.h    = parameters.cell_size;
     if (given_bodies != nullptr)
       {
+        if (s.parallel)
+          *given_bodies = gather_bodies(*given_bodies, s.communicator);
+        *given_bodies = in_canonical_order(*given_bodies);
         check_given_points(*given_bodies, parameters);
         // GIMP's particle domains stay within half a cell, and inside the grid: a domain that
         // reached beyond the grid's face would lose the weight of the nodes beyond it.

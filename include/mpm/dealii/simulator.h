@@ -39,6 +39,9 @@ namespace mpm
     // state handed over from elsewhere, e.g. an FEM analysis (fem_handover.h). Every point
     // must lie inside the grid and name one of the prm's materials (by index, Materials/Names
     // order); the elastic wave speed of the time step comes from the points' own density.
+    // On several ranks each rank gives its own points (those of its FEM cells); they are
+    // gathered, and each rank keeps those in its MPM cells. The points' ids follow their
+    // positions (lexicographic order, x first), on any number of ranks.
     void setup(std::vector<GeneratedBody<dim>> bodies);
     // One explicit step of the scheme, then the history row and output due after it.
     // Returns the time step taken. Throws if the run has become unstable.
