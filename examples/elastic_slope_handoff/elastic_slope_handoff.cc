@@ -8,7 +8,8 @@
 // point per quadrature point (placement (a) of doc/library.md), and the MPM steps on. Since the
 // FEM state is in equilibrium, the MPM must find the slope at rest: no damping, gravity at once,
 // twenty elastic wave transits, and the largest point speed and stress change measured in the units
-// of the problem, sqrt(g H) and rho g H.
+// of the problem, sqrt(g H) and rho g H. Plane strain by default; `elastic_slope_handoff 3` runs the
+// slope extruded in 3D.
 //
 // The parts, top to bottom:
 //   1. the slope: a mesh of a box, its top bent into the slope's profile; material_id 0;
@@ -45,12 +46,13 @@
 #include <algorithm>
 #include <cmath>
 #include <iostream>
+#include <string>
+#include <vector>
 
 using namespace dealii;
 
 namespace
 {
-  constexpr int dim = 2;
   // Slope: 30 m long, 10 m high behind the crest (x < 10 m), falling at 1:2 (26.6 deg) to 5 m at
   // x = 20 m, then level; dry soil, rho = 2000 kg/m^3, E = 20 MPa, nu = 0.3, g = 9.81 m/s^2.
   constexpr double length = 30, H = 10, rho = 2000, E = 20e6, nu = 0.3, g = 9.81;
@@ -66,17 +68,32 @@ namespace
   {};
 } // namespace
 
-int main(int argc, char **argv)
+// The whole program for a dimension: 2 (plane strain, the default) or 3 (the same slope extruded
+// 2 m in y between rollers: `elastic_slope_handoff 3`).
+template <int dim>
+int run()
 {
-  Utilities::MPI::MPI_InitFinalize mpi(argc, argv, 1);
-  try
+  {
     {
-      // 1. The slope: 60 x 20 cells of a box, each point's height scaled to the slope's profile.
+      // 1. The slope: 60 x 20 cells of a box (x 30 m, height H; in 3D 4 cells across 2 m in y),
+      // each point's height scaled to the slope's profile. Height is the last coordinate.
       Triangulation<dim> triangulation;
-      GridGenerator::subdivided_hyper_rectangle(triangulation, {60, 20}, Point<dim>(0, 0), Point<dim>(length, H),
-                                                /*colorize=*/true); // ids 0, 1: x = 0, 30; 2, 3: y = 0, H
-      GridTools::transform([](const Point<dim> &p) { return Point<dim>(p[0], p[1] * surface(p[0]) / H); },
-                           triangulation);
+      std::vector<unsigned int> cells{60};
+      Point<dim>                upper;
+      upper[0] = length;
+      if (dim == 3)
+        cells.push_back(4), upper[1] = 2;
+      cells.push_back(20);
+      upper[dim - 1] = H;
+      // colorize: boundary ids 0, 1 at x = 0, 30; 2, 3 at the next axis' ends; 4, 5 in 3D.
+      GridGenerator::subdivided_hyper_rectangle(triangulation, cells, Point<dim>(), upper, /*colorize=*/true);
+      GridTools::transform(
+        [](const Point<dim> &p) {
+          Point<dim> q = p;
+          q[dim - 1]   = p[dim - 1] * surface(p[0]) / H;
+          return q;
+        },
+        triangulation);
       for (const auto &cell : triangulation.active_cell_iterators())
         cell->set_material_id(0); // colorize numbered the cells too: one soil here
 
@@ -86,11 +103,14 @@ int main(int argc, char **argv)
       dof_handler.distribute_dofs(fe);
       const FEValuesExtractors::Vector displacement(0);
 
-      AffineConstraints<double> constraints;
-      VectorTools::interpolate_boundary_values(dof_handler, 2, Functions::ZeroFunction<dim>(dim), constraints);
-      for (const types::boundary_id side : {0, 1}) // rollers: u_x = 0
-        VectorTools::interpolate_boundary_values(dof_handler, side, Functions::ZeroFunction<dim>(dim), constraints,
-                                                 fe.component_mask(FEValuesExtractors::Scalar(0)));
+      // A fixed base; rollers on the sides (the normal component fixed).
+      AffineConstraints<double>     constraints;
+      const types::boundary_id base = 2 * (dim - 1);
+      VectorTools::interpolate_boundary_values(dof_handler, base, Functions::ZeroFunction<dim>(dim), constraints);
+      for (int axis = 0; axis < dim - 1; ++axis)
+        for (const types::boundary_id side : {2 * axis, 2 * axis + 1})
+          VectorTools::interpolate_boundary_values(dof_handler, side, Functions::ZeroFunction<dim>(dim), constraints,
+                                                   fe.component_mask(FEValuesExtractors::Scalar(axis)));
       constraints.close();
 
       const IndexSet         owned = dof_handler.locally_owned_dofs();
@@ -108,7 +128,7 @@ int main(int argc, char **argv)
       Vector<double>     cell_rhs(n_dofs);
       std::vector<types::global_dof_index> dofs(n_dofs);
       Tensor<1, dim>                       gravity;
-      gravity[1] = -g;
+      gravity[dim - 1] = -g;
       for (const auto &cell : dof_handler.active_cell_iterators())
         {
           fe_values.reinit(cell);
@@ -155,37 +175,39 @@ int main(int argc, char **argv)
           fe_values.reinit(cell);
           fe_values[displacement].get_function_symmetric_gradients(solution, strain);
           const auto points = history.get_data(cell);
+          const int voigt[3][3] = {{0, 3, 5}, {3, 1, 4}, {5, 4, 2}}; // xx, yy, zz, xy, yz, xz
           for (unsigned int q = 0; q < n_q; ++q)
             {
               const double tr = trace(strain[q]);
-              points[q]->stress[0] = lambda * tr + 2 * mu * strain[q][0][0]; // xx
-              points[q]->stress[1] = lambda * tr + 2 * mu * strain[q][1][1]; // yy
-              points[q]->stress[2] = lambda * tr;                            // zz (plane strain)
-              points[q]->stress[3] = 2 * mu * strain[q][0][1];               // xy
+              for (int c = 0; c < mpm::n_voigt; ++c)
+                points[q]->stress[c] = 0;
+              points[q]->stress[2] = lambda * tr; // zz: in 2D plane strain's, in 3D overwritten below
+              for (int d = 0; d < dim; ++d)
+                for (int e = d; e < dim; ++e)
+                  points[q]->stress[voigt[d][e]] = (d == e ? lambda * tr : 0.0) + 2 * mu * strain[q][d][e];
             }
         }
 
       // 4. The MPM scene: the same soil, a grid of 0.5 m cells around the slope with 5 m of room
       // above it, the FEM's boundaries (rollers on the sides, a fixed base), no damping, gravity at
       // once. Its bodies section is not used: the points come from the FEM.
-      mpm::Parameters parameters = mpm::parameters_from_string(R"(
-        set Dimension = 2
-        subsection Grid
-          set Lower corner = 0, 0
-          set Upper corner = 30, 15
-          set Cell size    = 0.5
-        end
-        subsection Boundary conditions
-          set x min = free-slip
-          set x max = free-slip
-          set y min = no-slip
-          set y max = free
-        end
+      const std::string grid_and_boundaries =
+        dim == 2 ? "set Dimension = 2\n"
+                   "subsection Grid\n set Lower corner = 0, 0\n set Upper corner = 30, 15\n set Cell size = 0.5\nend\n"
+                   "subsection Boundary conditions\n set x min = free-slip\n set x max = free-slip\n"
+                   " set y min = no-slip\n set y max = free\nend\n"
+                   "subsection Solver\n set Gravity = 0, -9.81\nend\n" :
+                   "set Dimension = 3\n"
+                   "subsection Grid\n set Lower corner = 0, 0, 0\n set Upper corner = 30, 2, 15\n"
+                   " set Cell size = 0.5\nend\n"
+                   "subsection Boundary conditions\n set x min = free-slip\n set x max = free-slip\n"
+                   " set y min = free-slip\n set y max = free-slip\n set z min = no-slip\n set z max = free\nend\n"
+                   "subsection Solver\n set Gravity = 0, 0, -9.81\nend\n";
+      mpm::Parameters parameters = mpm::parameters_from_string(grid_and_boundaries + R"(
         subsection Solver
           set Shape function     = GIMP
           set GIMP domain update = det F
           set Local damping      = 0
-          set Gravity            = 0, -9.81
         end
         subsection Materials
           set Names = soil
@@ -218,7 +240,12 @@ int main(int argc, char **argv)
           simulator.advance();
           const mpm::HostPoints<dim, double> now = simulator.points();
           for (int i = 0; i < now.size(); ++i)
-            fastest = std::max(fastest, std::hypot(now.velocity[0][i], now.velocity[1][i]));
+            {
+              double speed = 0;
+              for (int d = 0; d < dim; ++d)
+                speed += now.velocity[d][i] * now.velocity[d][i];
+              fastest = std::max(fastest, std::sqrt(speed));
+            }
         }
       simulator.finish();
 
@@ -244,6 +271,16 @@ int main(int argc, char **argv)
                               "FAILED: the slope handed over moves")
                 << std::endl;
       return at_rest ? 0 : 1;
+    }
+  }
+}
+
+int main(int argc, char **argv)
+{
+  Utilities::MPI::MPI_InitFinalize mpi(argc, argv, 1);
+  try
+    {
+      return argc > 1 && std::string(argv[1]) == "3" ? run<3>() : run<2>();
     }
   catch (const std::exception &e)
     {
