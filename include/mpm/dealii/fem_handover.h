@@ -29,7 +29,6 @@
 
 #include <cmath>
 #include <functional>
-#include <limits>
 #include <map>
 #include <string>
 #include <type_traits>
