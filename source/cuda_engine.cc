@@ -118,6 +118,10 @@ namespace mpm
                                                 const ShapeFunction shape)
   {
 #ifdef MPM_CUDA_ENGINE
+    for (const MaterialParameters<double> &m : materials)
+      AssertThrow(m.model != MaterialModel::user_defined,
+                  dealii::ExcMessage("Parameter 'Backend/Backend': 'cuda' cannot run a constitutive model defined "
+                                     "outside the library (UserConstitutiveModel); use 'cpu'."));
     std::string why;
     AssertThrow(cuda::device_count(&why) > 0,
                 dealii::ExcMessage("Parameter 'Backend/Backend': 'cuda' was asked for, but no CUDA device is usable (" +

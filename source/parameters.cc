@@ -369,6 +369,9 @@ namespace mpm
           m.model == MaterialModel::drucker_prager ? &m.drucker_prager.strength :
           m.model == MaterialModel::mohr_coulomb   ? &m.mohr_coulomb.strength :
                                                      nullptr;
+        if (field != "none" && m.model == MaterialModel::user_defined)
+          fail(where + "Parameter", "a random field needs a built-in model (linear elastic, drucker prager, mohr "
+                                    "coulomb); '" + model + "' is defined outside the library.");
         if (field == "cohesion" || field == "friction angle")
           {
             if (strength == nullptr)
@@ -485,6 +488,12 @@ namespace mpm
     backend       = prm.get("Backend");
     sort_interval = prm.get_integer("Sort interval");
     prm.leave_subsection();
+    if (backend == "cuda")
+      for (unsigned int i = 0; i < materials.size(); ++i)
+        if (materials[i].model == MaterialModel::user_defined)
+          fail("Backend/Backend", "cuda cannot run material '" + material_names[i] + "': its model '" +
+                                    material_models[i] + "' is defined outside the library and runs on the "
+                                    "CPU backend only (Backend = cpu).");
   }
 
   namespace

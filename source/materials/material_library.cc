@@ -1,5 +1,10 @@
 #include <mpm/dealii/material_library.h>
 
+#include <deal.II/base/exceptions.h>
+
+#include <mutex>
+#include <vector>
+
 namespace mpm
 {
   std::map<std::string, MaterialPlugin> &material_library()
@@ -10,6 +15,11 @@ namespace mpm
 
   bool register_material(const std::string &name, const MaterialPlugin &plugin)
   {
+    AssertThrow(!name.empty() && name.find_first_of("|,") == std::string::npos,
+                dealii::ExcMessage("A constitutive model's name must be non-empty and contain neither '|' nor ','; "
+                                   "got '" + name + "'."));
+    AssertThrow(material_library().count(name) == 0,
+                dealii::ExcMessage("The constitutive model name '" + name + "' is registered twice."));
     material_library()[name] = plugin;
     return true;
   }
@@ -20,5 +30,26 @@ namespace mpm
     for (const auto &entry : material_library())
       names += (names.empty() ? "" : "|") + entry.first;
     return names;
+  }
+
+  MaterialParameters<double> user_defined_material(std::shared_ptr<const UserConstitutiveModel> model)
+  {
+    AssertThrow(model != nullptr, dealii::ExcMessage("user_defined_material: no model given."));
+    // The parsed models live as long as the program: MaterialParameters are plain data copied
+    // into engines that outlive any one Parameters object.
+    static std::mutex                                                 mutex;
+    static std::vector<std::shared_ptr<const UserConstitutiveModel>> keep_alive;
+    {
+      std::lock_guard<std::mutex> lock(mutex);
+      keep_alive.push_back(model);
+    }
+    MaterialParameters<double> m{};
+    m.model      = MaterialModel::user_defined;
+    m.elastic    = model->elastic_parameters();
+    m.user_model = model.get();
+    const LinearElasticParameters<double> &e = m.elastic;
+    AssertThrow(e.youngs_modulus > 0 && e.poissons_ratio > -1 && e.poissons_ratio < 0.5,
+                dealii::ExcMessage("The model's elastic_parameters() must give E > 0 and -1 < nu < 0.5."));
+    return m;
   }
 } // namespace mpm

@@ -1,12 +1,16 @@
 // The constitutive models known to the core, dispatched by a model tag so that
-// device code needs no virtual calls. Adding a model: one header with its
+// device code needs no virtual calls. Adding a built-in model: one header with its
 // parameters and MPM_HOST_DEVICE update, one enum value, one case below, and one
-// registration file in the deal.II layer (source/materials/).
+// registration file in the deal.II layer (source/materials/). A model written outside
+// the library (user_model.h) is the tag user_defined and a pointer; CPU backend only.
 #pragma once
 
 #include <mpm/core/material/drucker_prager.h>
 #include <mpm/core/material/linear_elastic.h>
 #include <mpm/core/material/mohr_coulomb.h>
+#include <mpm/core/material/user_model.h>
+
+#include <type_traits>
 
 namespace mpm
 {
@@ -14,7 +18,8 @@ namespace mpm
   {
     linear_elastic = 0,
     drucker_prager = 1, // non-associated, tension cut-off, inner fit to Mohr-Coulomb
-    mohr_coulomb   = 2  // non-associated, principal-space return (plane, edge, apex)
+    mohr_coulomb   = 2, // non-associated, principal-space return (plane, edge, apex)
+    user_defined   = 3  // UserConstitutiveModel, a virtual call per point (CPU only)
   };
 
   // A material parameter that varies from point to point (a random field sampled at the
@@ -39,6 +44,8 @@ namespace mpm
     // at which plasticity is switched on); eps_p is then left unchanged.
     bool plasticity_enabled = true;
     FieldParameter field_parameter = FieldParameter::none;
+    // model == user_defined: the model (host memory; owned by the material library).
+    const UserConstitutiveModel *user_model = nullptr;
   };
 
   // Per-point state a constitutive update reads and writes.
@@ -94,6 +101,12 @@ namespace mpm
         case MaterialModel::mohr_coulomb:
           mohr_coulomb_update(m.elastic, m.mohr_coulomb, m.plasticity_enabled, d_eps, d_spin, state.stress,
                               state.plastic_strain);
+          break;
+        case MaterialModel::user_defined:
+#ifndef __CUDA_ARCH__
+          if constexpr (std::is_same_v<Real, double>)
+            m.user_model->update_stress(d_eps, d_spin, m.plasticity_enabled, state.stress, state.plastic_strain);
+#endif
           break;
         case MaterialModel::linear_elastic:
         default:
