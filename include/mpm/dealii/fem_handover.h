@@ -66,6 +66,54 @@ namespace mpm
     struct has_ghost_elements_query<VectorType, std::void_t<decltype(std::declval<const VectorType &>().has_ghost_elements())>>
       : std::true_type
     {};
+
+    // The checks both placements make of their input; throw naming what is wrong.
+    template <int dim, typename VectorType>
+    void check_handover_input(const dealii::DoFHandler<dim> &dof_handler, const VectorType &displacement,
+                              const QuadraturePointStateFunction<dim> &state)
+    {
+      const dealii::FiniteElement<dim> &fe = dof_handler.get_fe();
+      AssertThrow(fe.n_components() >= static_cast<unsigned int>(dim),
+                  dealii::ExcMessage("FEM hand-over: the finite element " + fe.get_name() + " has " +
+                                     std::to_string(fe.n_components()) + " vector component(s); the displacement needs " +
+                                     std::to_string(dim) + " (e.g. FESystem<dim>(FE_Q<dim>(2), dim))."));
+      AssertThrow(displacement.size() == dof_handler.n_dofs(),
+                  dealii::ExcMessage("FEM hand-over: the displacement vector has " + std::to_string(displacement.size()) +
+                                     " entries, the DoFHandler " + std::to_string(dof_handler.n_dofs()) + " DoFs."));
+      AssertThrow(static_cast<bool>(state), dealii::ExcMessage("FEM hand-over: no quadrature-point state was given."));
+      if constexpr (has_ghost_elements_query<VectorType>::value)
+        AssertThrow(displacement.has_ghost_elements() ||
+                      dealii::Utilities::MPI::n_mpi_processes(dof_handler.get_communicator()) == 1,
+                    dealii::ExcMessage("FEM hand-over: the displacement vector must hold ghost values (a vector "
+                                       "initialised with the locally relevant DoFs) on several MPI ranks."));
+    }
+
+    // Small strain sym(grad u) of point i, Voigt xx, yy, zz, xy, yz, xz with tensor shear components.
+    template <int dim>
+    void set_small_strain(HostPoints<dim, double> &p, const int i, const dealii::Tensor<2, dim> &grad_u)
+    {
+      const int voigt[3][3] = {{0, 3, 5}, {3, 1, 4}, {5, 4, 2}};
+      for (int c = 0; c < n_voigt; ++c)
+        p.strain[c][i] = 0;
+      for (int d = 0; d < dim; ++d)
+        for (int e = d; e < dim; ++e)
+          p.strain[voigt[d][e]][i] = 0.5 * (grad_u[d][e] + grad_u[e][d]);
+    }
+
+    // The state function of a CellDataStorage (step-44's quadrature-point history).
+    template <int dim, typename CellIteratorType, typename DataType>
+    QuadraturePointStateFunction<dim> state_from_storage(const dealii::CellDataStorage<CellIteratorType, DataType> &history)
+    {
+      static_assert(std::is_base_of<QuadraturePointState, DataType>::value,
+                    "the quadrature-point data type must derive from mpm::QuadraturePointState");
+      return [&history](const typename dealii::DoFHandler<dim>::active_cell_iterator &cell, const unsigned int q) {
+        const auto data = history.try_get_data(CellIteratorType(cell));
+        AssertThrow(data && q < data->size(),
+                    dealii::ExcMessage("FEM hand-over: the quadrature-point history holds no state for point " +
+                                       std::to_string(q) + " of cell " + cell->id().to_string() + "."));
+        return static_cast<const QuadraturePointState &>(*(*data)[q]);
+      };
+    }
   } // namespace internal
 
   // Placement (a), with the state of each quadrature point from a function (cell, q) -> state.
@@ -81,19 +129,7 @@ namespace mpm
                                                  const dealii::Mapping<dim> &mapping = dealii::StaticMappingQ1<dim>::mapping)
   {
     const dealii::FiniteElement<dim> &fe = dof_handler.get_fe();
-    AssertThrow(fe.n_components() >= static_cast<unsigned int>(dim),
-                dealii::ExcMessage("FEM hand-over: the finite element " + fe.get_name() + " has " +
-                                   std::to_string(fe.n_components()) + " vector component(s); the displacement needs " +
-                                   std::to_string(dim) + " (e.g. FESystem<dim>(FE_Q<dim>(2), dim))."));
-    AssertThrow(displacement.size() == dof_handler.n_dofs(),
-                dealii::ExcMessage("FEM hand-over: the displacement vector has " + std::to_string(displacement.size()) +
-                                   " entries, the DoFHandler " + std::to_string(dof_handler.n_dofs()) + " DoFs."));
-    AssertThrow(static_cast<bool>(state), dealii::ExcMessage("FEM hand-over: no quadrature-point state was given."));
-    if constexpr (internal::has_ghost_elements_query<VectorType>::value)
-      AssertThrow(displacement.has_ghost_elements() ||
-                    dealii::Utilities::MPI::n_mpi_processes(dof_handler.get_communicator()) == 1,
-                  dealii::ExcMessage("FEM hand-over: the displacement vector must hold ghost values (a vector "
-                                     "initialised with the locally relevant DoFs) on several MPI ranks."));
+    internal::check_handover_input(dof_handler, displacement, state);
 
     dealii::FEValues<dim> fe_values(mapping, fe, quadrature,
                                     dealii::update_values | dealii::update_gradients |
@@ -144,13 +180,7 @@ namespace mpm
                 for (int e = 0; e < dim; ++e)
                   p.deformation_gradient[d * dim + e][i] = F[d][e];
               }
-            // Small strain sym(grad u), Voigt xx, yy, zz, xy, yz, xz with tensor shear components.
-            const int voigt[3][3] = {{0, 3, 5}, {3, 1, 4}, {5, 4, 2}};
-            for (int c = 0; c < n_voigt; ++c)
-              p.strain[c][i] = 0;
-            for (int d = 0; d < dim; ++d)
-              for (int e = d; e < dim; ++e)
-                p.strain[voigt[d][e]][i] = 0.5 * (grad_u_q[q][d][e] + grad_u_q[q][e][d]);
+            internal::set_small_strain(p, i, grad_u_q[q]);
             for (int c = 0; c < n_voigt; ++c)
               p.stress[c][i] = s.stress[c];
             if (dim == 2)
@@ -176,16 +206,7 @@ namespace mpm
                                                  const std::map<dealii::types::material_id, HandoverMaterial> &materials,
                                                  const dealii::Mapping<dim> &mapping = dealii::StaticMappingQ1<dim>::mapping)
   {
-    static_assert(std::is_base_of<QuadraturePointState, DataType>::value,
-                  "the quadrature-point data type must derive from mpm::QuadraturePointState");
-    const QuadraturePointStateFunction<dim> state =
-      [&](const typename dealii::DoFHandler<dim>::active_cell_iterator &cell, const unsigned int q) {
-        const auto data = history.try_get_data(CellIteratorType(cell));
-        AssertThrow(data && q < data->size(),
-                    dealii::ExcMessage("FEM hand-over: the quadrature-point history holds no state for point " +
-                                       std::to_string(q) + " of cell " + cell->id().to_string() + "."));
-        return static_cast<const QuadraturePointState &>(*(*data)[q]);
-      };
-    return points_at_quadrature_points(dof_handler, displacement, quadrature, state, materials, mapping);
+    return points_at_quadrature_points(dof_handler, displacement, quadrature,
+                                       internal::state_from_storage<dim>(history), materials, mapping);
   }
 } // namespace mpm
