@@ -4,6 +4,7 @@
 #include <deal.II/base/exceptions.h>
 #include <deal.II/base/utilities.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <sstream>
@@ -253,6 +254,31 @@ namespace mpm
                       "partition (a cell weighs 1 + Point weight x its points).");
     prm.leave_subsection();
 
+    prm.enter_subsection("Initial state");
+    prm.declare_entry("Source", "prm bodies", Patterns::Selection("prm bodies|FEM file"),
+                      "prm bodies: the points of Material points/Body i (with their Initial stress: none or "
+                      "geostatic). FEM file: the state an FEM program saved with mpm::save_fem_state (displacement, "
+                      "quadrature-point stresses and plastic strain), handed over as Placement says; the bodies "
+                      "of Material points are then not used.");
+    prm.declare_entry("FEM file", "", Patterns::Anything(),
+                      "Source = FEM file: the file written by mpm::save_fem_state (a path, relative to the "
+                      "working directory).");
+    prm.declare_entry("Placement", "quadrature points", Patterns::Selection("quadrature points|lattice"),
+                      "quadrature points: one material point per quadrature point of the FEM, volume its JxW "
+                      "(placement (a)). lattice: Points per cell direction^dim points per MPM cell inside the "
+                      "deformed body, stresses projected from the quadrature points (placement (b)).");
+    prm.declare_entry("Points per cell direction", "2", Patterns::Integer(1, 20),
+                      "Placement = lattice: points per MPM cell along each direction.");
+    prm.declare_entry("Projection degree", "-1", Patterns::Integer(-1, 10),
+                      "Placement = lattice: polynomial degree of the cell-wise L2 projection of the quadrature-point "
+                      "state (FE_DGQ); -1 = the FEM's displacement degree. Needs degree + 1 quadrature points per "
+                      "direction.");
+    prm.declare_entry("Materials", "", Patterns::Anything(),
+                      "Source = FEM file: 'id: name, density; ...' for every material_id of the FEM mesh: the MPM "
+                      "material (one of Materials/Names) and the density in kg/m^3 (> 0), e.g. '0: soil, 2000; 1: "
+                      "rock, 2400'.");
+    prm.leave_subsection();
+
     prm.enter_subsection("Backend");
     prm.declare_entry("Backend", "cpu", Patterns::Selection("cpu|cuda"),
                       "Where the MPM step runs: cpu (threads through TBB) or cuda (needs a build with "
@@ -394,8 +420,51 @@ namespace mpm
         material_models.push_back(model);
       }
 
+    prm.enter_subsection("Initial state");
+    initial_state_source     = prm.get("Source");
+    fem_file                 = prm.get("FEM file");
+    fem_placement            = prm.get("Placement");
+    fem_points_per_direction = prm.get_integer("Points per cell direction");
+    fem_projection_degree    = prm.get_integer("Projection degree");
+    if (initial_state_source == "FEM file")
+      {
+        if (fem_file.empty())
+          fail("Initial state/FEM file", "Source = FEM file needs the file's name.");
+        for (const std::string &item : dealii::Utilities::split_string_list(prm.get("Materials"), ';'))
+          {
+            const std::string where = "Initial state/Materials";
+            const auto        colon = item.find(':');
+            const std::vector<std::string> rest =
+              colon == std::string::npos ? std::vector<std::string>() :
+                                           dealii::Utilities::split_string_list(item.substr(colon + 1), ',');
+            if (rest.size() != 2)
+              fail(where, "'" + item + "' is not of the form 'id: material name, density'.");
+            int    id      = -1;
+            double density = 0;
+            try
+              {
+                id      = dealii::Utilities::string_to_int(dealii::Utilities::trim(item.substr(0, colon)));
+                density = dealii::Utilities::string_to_double(rest[1]);
+              }
+            catch (...)
+              {
+                fail(where, "'" + item + "' is not of the form 'id: material name, density'.");
+              }
+            const auto name = std::find(material_names.begin(), material_names.end(), rest[0]);
+            if (id < 0 || id > 255 || !(density > 0) || name == material_names.end() || fem_materials.count(id))
+              fail(where, "'" + item + "': the id must be a material_id 0..255 given once, the name one of "
+                          "Materials/Names, the density > 0.");
+            if (materials[name - material_names.begin()].field_parameter != FieldParameter::none)
+              fail(where, "material '" + rest[0] + "' has a random field, which the FEM hand-over does not carry.");
+            fem_materials[id] = {static_cast<unsigned int>(name - material_names.begin()), density};
+          }
+        if (fem_materials.empty())
+          fail("Initial state/Materials", "Source = FEM file needs at least one 'id: material name, density'.");
+      }
+    prm.leave_subsection();
+
     prm.enter_subsection("Material points");
-    const unsigned int n_bodies = prm.get_integer("Number of bodies");
+    const unsigned int n_bodies = initial_state_source == "FEM file" ? 0 : prm.get_integer("Number of bodies");
     for (unsigned int b = 1; b <= n_bodies; ++b)
       {
         const std::string where = "Material points/Body " + std::to_string(b) + "/";

@@ -1,6 +1,7 @@
 #include <mpm/core/migration.h>
 #include <mpm/dealii/background_grid.h>
 #include <mpm/dealii/cuda_engine.h>
+#include <mpm/dealii/fem_state_file.h>
 #include <mpm/dealii/engine.h>
 #include <mpm/dealii/material_points.h>
 #include <mpm/dealii/output_writer.h>
@@ -723,12 +724,27 @@ namespace mpm
     s.engine->load(new_points, snapshot.labels);
   }
 
+  namespace
+  {
+    template <int dim>
+    void run_from(const Parameters &parameters, MPI_Comm communicator)
+    {
+      Simulator<dim> simulator(parameters, communicator);
+      if (parameters.initial_state_source != "FEM file")
+        return simulator.run();
+      simulator.setup(load_fem_state_points<dim>(parameters, communicator));
+      while (!simulator.finished())
+        simulator.advance();
+      simulator.finish();
+    }
+  } // namespace
+
   void run_simulation(const Parameters &parameters, MPI_Comm communicator)
   {
     if (parameters.dim == 2)
-      Simulator<2>(parameters, communicator).run();
+      run_from<2>(parameters, communicator);
     else
-      Simulator<3>(parameters, communicator).run();
+      run_from<3>(parameters, communicator);
   }
 
   template class Simulator<2>;

@@ -2,7 +2,12 @@
 // distributed displacement) stepped 100 steps by the MPM, writing its particle tables into the
 // folder given as argument. Run on 1 and 2 ranks by ctest, whose compare_np.py asserts the
 // results agree point by point (each rank hands over its own cells' points; setup gathers them).
+// A second argument "lattice" hands over with placement (b), 2x2 points per MPM cell.
+// "fem_handover_run --save FILE" writes the FEM state instead (fem_state_file.h), for the
+// executable's Initial state/Source = FEM file.
 #include <mpm/dealii/fem_handover.h>
+#include <mpm/dealii/fem_handover_lattice.h>
+#include <mpm/dealii/fem_state_file.h>
 #include <mpm/dealii/parameters.h>
 #include <mpm/dealii/simulator.h>
 
@@ -44,7 +49,9 @@ int main(int argc, char **argv)
   Utilities::MPI::MPI_InitFinalize mpi(argc, argv, 1);
   try
     {
-      AssertThrow(argc == 2, ExcMessage("usage: fem_handover_run OUTPUT_DIRECTORY"));
+      const bool save = argc == 3 && std::string(argv[1]) == "--save";
+      AssertThrow(argc == 2 || (argc == 3 && (save || std::string(argv[2]) == "lattice")),
+                  ExcMessage("usage: fem_handover_run OUTPUT_DIRECTORY [lattice] | --save FILE"));
       parallel::distributed::Triangulation<dim> triangulation(MPI_COMM_WORLD);
       GridGenerator::subdivided_hyper_rectangle(triangulation, {4, 2}, Point<dim>(0, 0), Point<dim>(4, 2));
       triangulation.refine_global(2);
@@ -68,9 +75,11 @@ int main(int argc, char **argv)
         return s;
       };
       const std::map<types::material_id, mpm::HandoverMaterial> materials{{0, {0, 1800}}};
-      const mpm::GeneratedBody<dim> body =
-        mpm::points_at_quadrature_points(dof_handler, u, QGauss<dim>(3), state, materials);
-
+      if (save)
+        {
+          mpm::save_fem_state(argv[2], dof_handler, u, QGauss<dim>(3), state);
+          return 0;
+        }
       mpm::Parameters parameters = mpm::parameters_from_string(std::string(R"(
         set Dimension = 2
         subsection Grid
@@ -102,6 +111,10 @@ int main(int argc, char **argv)
           set Write particle table = true
           set Progress interval    = 0
           set Directory            = )") + argv[1] + "\nend\n");
+      const mpm::GeneratedBody<dim> body =
+        argc == 3 ? mpm::points_on_lattice(dof_handler, u, QGauss<dim>(3), state, materials,
+                                           mpm::lattice_handover<dim>(parameters, 2)) :
+                    mpm::points_at_quadrature_points(dof_handler, u, QGauss<dim>(3), state, materials);
       mpm::Simulator<dim> simulator(parameters, MPI_COMM_WORLD);
       simulator.setup({body});
       while (!simulator.finished())

@@ -93,7 +93,8 @@ namespace
     catch (const std::exception &e)
       {
         const bool named = std::string(e.what()).find(text) != std::string::npos;
-        std::printf("%s: %s\n", named ? "refused" : "message without '" + text + "'", e.what());
+        const std::string verdict = named ? std::string("refused") : "message without '" + text + "'";
+        std::printf("%s: %s\n", verdict.c_str(), e.what());
         return named;
       }
     return false;

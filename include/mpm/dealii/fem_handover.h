@@ -12,6 +12,7 @@
 // det(F) JxW, mass = density JxW (JxW in the mesh's reference configuration), small strain
 // sym(grad u), and the quadrature point's stress and plastic strain. The MPM background grid
 // is the prm's (Grid), independent of the FEM mesh; points outside it are refused by setup().
+// Placement (b), points on the MPM's lattice with the state projected: fem_handover_lattice.h.
 // Header-only: it is instantiated for the user's vector type.
 #pragma once
 

@@ -11,6 +11,7 @@
 #include <deal.II/base/parameter_handler.h>
 
 #include <array>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -89,6 +90,15 @@ namespace mpm
     double resort_distance;        // re-sort at this fraction of the safe distance outside a home cell
     double load_balance_threshold; // repartition when max/mean work per rank exceeds it; 0 = never
     double point_weight;           // work of one point relative to one empty cell
+
+    // Initial state: "prm bodies" (Material points) or "FEM file" (fem_state_file.h)
+    std::string  initial_state_source = "prm bodies";
+    std::string  fem_file;
+    std::string  fem_placement = "quadrature points"; // or "lattice"
+    unsigned int fem_points_per_direction = 2;
+    int          fem_projection_degree    = -1;
+    // FEM material_id -> (index into materials, density)
+    std::map<unsigned int, std::pair<unsigned int, double>> fem_materials;
 
     // Backend
     std::string backend;

@@ -1,0 +1,31 @@
+#!/bin/bash
+# The prm route of the FEM hand-over (Initial state/Source = FEM file): an FEM state saved by
+# fem_handover_run on 2 ranks, read by the dealii-mpm executable on 1 and 2 ranks, must give the
+# points the API gives the FEM program itself (fem_handover_run on 1 rank), in both placements,
+# after 100 steps (compare_np.py: positions and stresses to 1e-10 of their magnitude).
+# Usage: fem_state_file.sh FEM_HANDOVER_RUN DEALII_MPM SOURCE_DIR WORK_DIR
+set -euo pipefail
+run=$1 exe=$2 src=$3 work=$4
+export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
+rm -rf "$work" && mkdir -p "$work" && cd "$work"
+mpirun --oversubscribe -np 2 "$run" --save state.fem-state
+"$run" api-a > api-a.log
+"$run" api-b lattice > api-b.log
+for placement in a b; do
+  for np in 1 2; do
+    mkdir -p "file-$placement-np$np" && cd "file-$placement-np$np"
+    mpirun --oversubscribe -np $np "$exe" "$src/tests/dealii/fem_state_file_$placement.prm" > run.log
+    cd ..
+    /usr/bin/python3 "$src/tests/prm/compare_np.py" "api-$placement" "file-$placement-np$np/output" --rtol 1e-10
+  done
+done
+# Bad input: a file that is not an FEM state, a material_id without an MPM material.
+echo "not a state" > broken.fem-state
+sed 's|../state.fem-state|broken.fem-state|' "$src/tests/dealii/fem_state_file_a.prm" > broken.prm
+! "$exe" broken.prm > broken.log 2>&1
+grep -q "is not an FEM state" broken.log
+sed 's|set Materials = 0: soil, 1800|set Materials = 3: soil, 1800|; s|../state.fem-state|state.fem-state|' \
+  "$src/tests/dealii/fem_state_file_a.prm" > unnamed.prm
+! "$exe" unnamed.prm > unnamed.log 2>&1
+grep -q "material_id 0, which the map of materials" unnamed.log
+echo "FEM file route: API and executable agree in both placements on 1 and 2 ranks; bad files refused"
