@@ -286,6 +286,19 @@ namespace mpm
             return position(a, d) < position(b, d);
         return false;
       });
+      // Two points at one position: the same FEM cells handed over twice, typically a serial
+      // Triangulation handed over by every rank of a run.
+      for (std::size_t k = 1; k < source.size(); ++k)
+        {
+          bool same = true;
+          for (int d = 0; d < dim; ++d)
+            same = same && position(source[k - 1], d) == position(source[k], d);
+          AssertThrow(!same, dealii::ExcMessage(
+                               "Simulator::setup(bodies): two points handed over at the same position (" +
+                               std::to_string(position(source[k], 0)) + ", " + std::to_string(position(source[k], 1)) +
+                               ", ...). On several MPI ranks each rank must hand over only its own cells: a "
+                               "parallel::distributed::Triangulation, or a serial mesh handed over by one rank."));
+        }
       std::vector<GeneratedBody<dim>> one(1);
       HostPoints<dim, double>        &to = one[0].points;
       to.resize(static_cast<int>(source.size()));

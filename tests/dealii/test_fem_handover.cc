@@ -6,7 +6,8 @@
 //    (the quadrature-point field reproduced at the points), to 1e-12 relative;
 //  - bad input stops with a message that says what is wrong: a scalar FE, a material_id the map
 //    does not name, a point outside the MPM grid, a cell without quadrature-point history, a
-//    material with a random field, a displacement vector of the wrong size.
+//    material with a random field, a displacement vector of the wrong size, the same points handed
+//    over twice.
 #include "../core/check.h"
 
 #include <mpm/dealii/fem_handover.h>
@@ -255,6 +256,11 @@ namespace
       mpm::Simulator<dim> s(mpm::parameters_from_string(scene<dim>()), MPI_COMM_WORLD);
       check(throws_naming([&]() { s.setup({unknown}); }, "has material index 5, but Materials/Names declares 2"),
             "an MPM material index out of range is refused");
+    }
+    {
+      mpm::Simulator<dim> s(mpm::parameters_from_string(scene<dim>()), MPI_COMM_WORLD);
+      check(throws_naming([&]() { s.setup({body, body}); }, "two points handed over at the same position"),
+            "the same cells handed over twice (a serial mesh on every rank) are refused");
     }
   }
 } // namespace
