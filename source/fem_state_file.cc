@@ -154,6 +154,11 @@ namespace mpm
         return s;
       };
 
+    for (const unsigned int id : cells.material_ids)
+      AssertThrow(parameters.fem_materials.count(id),
+                  ExcMessage("Parameter 'Initial state/Materials': cells of '" + file + "' have material_id " +
+                             std::to_string(id) + ", which it does not map to an MPM material ('" +
+                             std::to_string(id) + ": name, density')."));
     std::map<dealii::types::material_id, HandoverMaterial> materials;
     for (const auto &[id, material] : parameters.fem_materials)
       materials[id] = HandoverMaterial{material.first, material.second};

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <exception>
+#include <string>
 
 namespace mpm_test
 {
@@ -25,6 +27,32 @@ namespace mpm_test
   inline void check_below(const double value, const double limit, const char *what)
   {
     check(std::isfinite(value) && value <= limit, what, value, limit);
+  }
+
+  // True if work() throws an exception whose message contains text; deal.II folds messages over
+  // lines, so runs of white space compare as one space. Prints the message otherwise.
+  template <typename Work>
+  bool throws_naming(Work &&work, const std::string &text)
+  {
+    try
+      {
+        work();
+      }
+    catch (const std::exception &e)
+      {
+        std::string message;
+        for (const char c : std::string(e.what()))
+          if (c != ' ' && c != '\n' && c != '\t' && c != '\r')
+            message += c;
+          else if (!message.empty() && message.back() != ' ')
+            message += ' ';
+        const bool named = message.find(text) != std::string::npos;
+        if (!named)
+          std::printf("message without '%s': %s\n", text.c_str(), e.what());
+        return named;
+      }
+    std::printf("no exception (expected one naming '%s')\n", text.c_str());
+    return false;
   }
 
   inline int finish(const char *name)

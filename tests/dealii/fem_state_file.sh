@@ -19,13 +19,19 @@ for placement in a b; do
     /usr/bin/python3 "$src/tests/prm/compare_np.py" "api-$placement" "file-$placement-np$np/output" --rtol 1e-10
   done
 done
-# Bad input: a file that is not an FEM state, a material_id without an MPM material.
+# Bad input: a file that is not an FEM state, a material_id without an MPM material. (set -e
+# does not act on "! cmd" or on the left of "&&": each check fails the test explicitly.)
+refused() { # refused PRM TEXT...: non-zero exit, and the message holds every TEXT
+  local prm=$1; shift
+  if "$exe" "$prm" > "$prm.log" 2>&1; then echo "FAILED: $prm was accepted"; exit 1; fi
+  for text in "$@"; do
+    grep -qF -- "$text" "$prm.log" || { cat "$prm.log"; echo "FAILED: no '$text' in the message"; exit 1; }
+  done
+}
 echo "not a state" > broken.fem-state
 sed 's|../state.fem-state|broken.fem-state|' "$src/tests/dealii/fem_state_file_a.prm" > broken.prm
-! "$exe" broken.prm > broken.log 2>&1
-grep -q "is not an FEM state" broken.log
+refused broken.prm "Initial state/FEM file" "is not an FEM state"
 sed 's|set Materials = 0: soil, 1800|set Materials = 3: soil, 1800|; s|../state.fem-state|state.fem-state|' \
   "$src/tests/dealii/fem_state_file_a.prm" > unnamed.prm
-! "$exe" unnamed.prm > unnamed.log 2>&1
-grep -q "material_id 0, which the map of materials" unnamed.log
+refused unnamed.prm "Initial state/Materials" "material_id 0"
 echo "FEM file route: API and executable agree in both placements on 1 and 2 ranks; bad files refused"

@@ -33,6 +33,7 @@
 
 using namespace dealii;
 using mpm_test::check;
+using mpm_test::throws_naming;
 using mpm_test::check_below;
 
 namespace
@@ -78,31 +79,6 @@ namespace
            "\n end\nend\n"
            "subsection Output\n set Directory = output-fem-handover\n set Output interval = 0\n"
            " set Write particles = false\n set Write grid fields = false\n set Progress interval = 0\nend\n";
-  }
-
-  template <typename Work>
-  bool throws_naming(Work &&work, const std::string &text)
-  {
-    try
-      {
-        work();
-      }
-    catch (const std::exception &e)
-      {
-        // deal.II folds the message over lines: compare with single spaces.
-        std::string message;
-        for (const char c : std::string(e.what()))
-          if (!std::isspace(static_cast<unsigned char>(c)))
-            message += c;
-          else if (!message.empty() && message.back() != ' ')
-            message += ' ';
-        const bool named = message.find(text) != std::string::npos;
-        if (!named)
-          std::printf("message without '%s': %s\n", text.c_str(), e.what());
-        return named;
-      }
-    std::printf("no exception (expected one naming '%s')\n", text.c_str());
-    return false;
   }
 
   template <int dim>

@@ -8,8 +8,8 @@
 //    rate k + 1 under refinement of the FEM mesh (k = 1 with Q1 and 2x2 Gauss, k = 2 with Q2 and
 //    3x3 Gauss, 2D; k = 1 in 3D): the observed rates between the two finest meshes must lie within
 //    0.25 of k + 1;
-//  - bad input stops with a message: a quadrature too coarse for the projection degree, a
-//    material_id the map does not name.
+//  - bad input stops with a message: a quadrature too coarse for the projection degree, one with
+//    enough points that cannot determine it (all on a line), a material_id the map does not name.
 #include "../core/check.h"
 
 #include <mpm/dealii/fem_handover_lattice.h>
@@ -33,6 +33,7 @@
 
 using namespace dealii;
 using mpm_test::check;
+using mpm_test::throws_naming;
 using mpm_test::check_below;
 
 namespace
@@ -236,23 +237,6 @@ namespace
     check(std::abs(rate - (k + 1)) < 0.25, "the projection converges at its order k + 1", rate, k + 1.0);
   }
 
-  template <typename Work>
-  bool throws_naming(Work &&work, const std::string &text)
-  {
-    try
-      {
-        work();
-      }
-    catch (const std::exception &e)
-      {
-        const bool named = std::string(e.what()).find(text) != std::string::npos;
-        if (!named)
-          std::printf("message without '%s': %s\n", text.c_str(), e.what());
-        return named;
-      }
-    std::printf("no exception where one naming '%s' was expected\n", text.c_str());
-    return false;
-  }
 } // namespace
 
 int main(int argc, char **argv)
@@ -279,8 +263,19 @@ int main(int argc, char **argv)
                 mpm::points_on_lattice(dof_handler, u, coarse, state_of<2>(coarse, zero), {{0, {0, 1000}}},
                                        lattice<2>(2));
               },
-              "quadrature points per cell"),
+              "needs at least 9 quadrature points per cell (3 per direction); the quadrature has 4"),
             "a quadrature too coarse for the projection degree is refused");
+      // Nine points on one line x = 1/2: as many as degree 2 needs, but x is not resolved.
+      std::vector<Point<2>> on_a_line;
+      for (unsigned int q = 0; q < 9; ++q)
+        on_a_line.emplace_back(0.5, (q + 0.5) / 9);
+      const Quadrature<2> line(on_a_line, std::vector<double>(9, 1.0 / 9));
+      check(throws_naming(
+              [&]() {
+                mpm::points_on_lattice(dof_handler, u, line, state_of<2>(line, zero), {{0, {0, 1000}}}, lattice<2>(2));
+              },
+              "its mass matrix is singular"),
+            "a quadrature that cannot determine the projection is refused");
       check(throws_naming(
               [&]() {
                 mpm::points_on_lattice(dof_handler, u, fine, state_of<2>(fine, zero), {{3, {0, 1000}}}, lattice<2>(2));

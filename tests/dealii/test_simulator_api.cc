@@ -20,6 +20,7 @@
 
 using namespace mpm;
 using mpm_test::check;
+using mpm_test::throws_naming;
 using mpm_test::check_below;
 
 namespace
@@ -49,22 +50,6 @@ namespace
     return worst;
   }
 
-  template <typename Work>
-  bool throws_naming(Work &&work, const std::string &text)
-  {
-    try
-      {
-        work();
-      }
-    catch (const std::exception &e)
-      {
-        const bool named = std::string(e.what()).find(text) != std::string::npos;
-        if (!named)
-          std::printf("message without '%s': %s\n", text.c_str(), e.what());
-        return named;
-      }
-    return false;
-  }
 } // namespace
 
 int main(int argc, char **argv)

@@ -23,6 +23,7 @@
 
 using namespace mpm;
 using mpm_test::check;
+using mpm_test::throws_naming;
 
 namespace
 {
@@ -83,22 +84,6 @@ namespace
     return simulator.points();
   }
 
-  template <typename Work>
-  bool throws_naming(Work &&work, const std::string &text)
-  {
-    try
-      {
-        work();
-      }
-    catch (const std::exception &e)
-      {
-        const bool named = std::string(e.what()).find(text) != std::string::npos;
-        const std::string verdict = named ? std::string("refused") : "message without '" + text + "'";
-        std::printf("%s: %s\n", verdict.c_str(), e.what());
-        return named;
-      }
-    return false;
-  }
 } // namespace
 
 int main(int argc, char **argv)

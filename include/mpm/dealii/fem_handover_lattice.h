@@ -10,7 +10,8 @@
 // material point at x: volume (h/n)^dim, deformation gradient F = I + grad u at X, mass
 // density * (h/n)^dim / det F, small strain sym(grad u). Stress and plastic strain come from the
 // quadrature points of X's cell by a cell-wise L2 projection onto discontinuous polynomials of
-// degree k (FE_DGQ(k); the DG mass matrix is cell-local, so no global solve), evaluated at X.
+// degree k (FE_DGQ(k); the DG mass matrix is cell-local, so no global solve), evaluated at X; a
+// plastic strain that the projection takes below zero is set to zero.
 // A point on the boundary between cells takes the cell with the smallest CellId, so that the
 // points do not depend on how the mesh is partitioned; each rank returns the points of its own
 // cells (Simulator::setup gathers them).
@@ -31,6 +32,7 @@
 #include <deal.II/grid/cell_id.h>
 #include <deal.II/lac/full_matrix.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <map>
@@ -118,8 +120,10 @@ namespace mpm
         if (cell->is_artificial())
           continue;
         const dealii::BoundingBox<dim> box = deformed.get_bounding_box(cell);
-        // Support points bound a curved cell only roughly: a margin of a tenth of its size.
-        const double margin = 0.1 * box.side_length(0) + 0.1 * (dim > 1 ? box.side_length(1) : 0.0);
+        // Support points bound a curved cell only roughly: a margin of a tenth of its largest side.
+        double margin = 0;
+        for (int d = 0; d < dim; ++d)
+          margin = std::max(margin, 0.1 * box.side_length(d));
         std::array<long, dim> first, last;
         for (int d = 0; d < dim; ++d)
           {
@@ -215,6 +219,24 @@ namespace mpm
               }
           }
         inverse.invert(mass);
+        // Enough quadrature points can still be placed so that M is singular (a rule that is not a
+        // tensor product): then M M^-1 is not I.
+        double off_identity = 0;
+        for (unsigned int a = 0; a < n_dg; ++a)
+          for (unsigned int b = 0; b < n_dg; ++b)
+            {
+              double product = 0;
+              for (unsigned int c = 0; c < n_dg; ++c)
+                product += mass(a, c) * inverse(c, b);
+              const double error = std::abs(product - (a == b ? 1.0 : 0.0));
+              if (!(error <= off_identity)) // NaN too, which std::max would drop
+                off_identity = error;
+            }
+        AssertThrow(std::isfinite(off_identity) && off_identity < 1e-8,
+                    ExcMessage("FEM hand-over on the lattice: the quadrature cannot determine a projection of degree " +
+                               std::to_string(degree) + " in cell " + id.to_string() +
+                               " (its mass matrix is singular). Give a lower LatticeHandover::projection_degree or "
+                               "a Gauss rule with degree + 1 points per direction."));
         for (unsigned int a = 0; a < n_dg; ++a)
           for (unsigned int b = 0; b < n_dg; ++b)
             for (int c = 0; c <= n_voigt; ++c)
@@ -259,7 +281,8 @@ namespace mpm
               p.stress[c][i] = values[c];
             if (dim == 2)
               p.stress[4][i] = p.stress[5][i] = 0; // plane strain: no out-of-plane shear
-            p.plastic_strain[i] = values[n_voigt];
+            // The projection may overshoot below zero next to a yielded region; eps_p >= 0.
+            p.plastic_strain[i] = std::max(0.0, values[n_voigt]);
             p.initial_volume[i] = volume / J;
             p.volume[i]         = volume;
             p.mass[i]           = match->second.density * volume / J;

@@ -104,6 +104,7 @@ namespace mpm
           break;
         case MaterialModel::user_defined:
 #ifndef __CUDA_ARCH__
+          // The interface is double; only the CPU backend runs user models, and it steps in double.
           if constexpr (std::is_same_v<Real, double>)
             m.user_model->update_stress(d_eps, d_spin, m.plasticity_enabled, state.stress, state.plastic_strain);
 #endif
