@@ -277,6 +277,23 @@ namespace mpm
                       "Source = FEM file: 'id: name, density; ...' for every material_id of the FEM mesh: the MPM "
                       "material (one of Materials/Names) and the density in kg/m^3 (> 0), e.g. '0: soil, 2000; 1: "
                       "rock, 2400'.");
+    prm.declare_entry("Equilibrate", "false", Patterns::Bool(),
+                      "true: before t = 0 (time stands still), damped steps with gravity in full and the points "
+                      "held in place, only their stresses following the grid, until the grid is at rest: the "
+                      "stresses then balance gravity in the MPM's own discretisation, and an undamped run starts "
+                      "in equilibrium. A state in equilibrium in an FEM is not exactly in equilibrium on the MPM "
+                      "grid (other shape functions, point quadrature), nor is a geostatic stress under a slope. "
+                      "The run reports how much the stresses changed.");
+    prm.declare_entry("Equilibration damping", "0.8", Patterns::Double(0, 1),
+                      "Equilibrate: the local damping coefficient of the damped steps (Solver/Local damping's "
+                      "form), 0 < D < 1.");
+    prm.declare_entry("Equilibration tolerance", "1e-6", Patterns::Double(0),
+                      "Equilibrate: at rest once the largest point speed has stayed below this multiple of "
+                      "sqrt(|g| H) for one elastic wave transit of H (H: the bodies' extent along gravity; "
+                      "without gravity the elastic wave speed replaces sqrt(|g| H)).");
+    prm.declare_entry("Equilibration maximum steps", "100000", Patterns::Integer(1),
+                      "Equilibrate: a state that is not at rest after this many damped steps stops the run "
+                      "(a body that fails under its own weight never comes to rest).");
     prm.leave_subsection();
 
     prm.enter_subsection("Backend");
@@ -426,6 +443,17 @@ namespace mpm
     fem_placement            = prm.get("Placement");
     fem_points_per_direction = prm.get_integer("Points per cell direction");
     fem_projection_degree    = prm.get_integer("Projection degree");
+    equilibrate                 = prm.get_bool("Equilibrate");
+    equilibration_damping       = prm.get_double("Equilibration damping");
+    equilibration_tolerance     = prm.get_double("Equilibration tolerance");
+    equilibration_maximum_steps = prm.get_integer("Equilibration maximum steps");
+    if (equilibrate && !(equilibration_damping > 0 && equilibration_damping < 1))
+      fail("Initial state/Equilibration damping", "must lie between 0 and 1 (exclusive) where Equilibrate = true.");
+    if (equilibrate && !(equilibration_tolerance > 0))
+      fail("Initial state/Equilibration tolerance", "must be > 0 where Equilibrate = true.");
+    if (equilibrate && gravity_ramp_time > 0)
+      fail("Initial state/Equilibrate", "the equilibration holds gravity in full; it needs Solver/Gravity ramp "
+                                        "time = 0 (a ramp after it would take the load off the state).");
     if (initial_state_source == "FEM file")
       {
         if (fem_file.empty())

@@ -17,6 +17,7 @@
 #include <future>
 #include <iomanip>
 #include <iostream>
+#include <unordered_map>
 
 namespace mpm
 {
@@ -116,7 +117,9 @@ namespace mpm
     long   n_resorts = 0, n_repartitions = 0;
     double balanced  = 1; // imbalance right after the last repartition: what p4est achieves
 
-    double time = 0, max_speed = 0, max_removed_speed = 0, work_of_gravity = 0, dt = 0;
+    double time = 0, max_speed = 0, max_removed_speed = 0, work_of_gravity = 0, dt = 0, gravity_power = 0;
+    bool                  equilibrating = false;
+    EquilibrationReport   equilibration;
     long   step = 0, n_removed = 0;
     double next_output = 0;
     std::chrono::steady_clock::time_point last_progress;
@@ -179,6 +182,163 @@ namespace mpm
       pcout << "  repartitioned the grid by work: max/mean work per rank " << before << " -> " << balanced
             << std::endl;
       return true;
+    }
+
+    // One step of the engine with the current settings, and what every step needs after it:
+    // the largest speeds over the ranks, the MPI re-sort when points have strayed, the
+    // stability check. Time and step counters are the caller's.
+    void engine_step(const double dt)
+    {
+      const StepReduction<double> r = timed("MPM step", [&]() { return engine->step(settings, dt); });
+      gravity_power     = r.gravity_power;
+      max_speed         = r.max_speed;
+      max_removed_speed = r.max_removed_speed;
+      const std::string when =
+        equilibrating ? "in damped step " + std::to_string(equilibration.steps + 1) + " of the equilibration" :
+                        "at t = " + dealii::Utilities::to_string(time + dt) + " s (step " +
+                          std::to_string(step + 1) + ")";
+      if (parallel)
+        {
+          // One reduction for the next time step and the migration test: the largest
+          // speed and the largest distance of a point outside its home cell.
+          double local[3] = {r.max_speed, engine->max_distance_outside_home_cells(), r.max_removed_speed},
+                 global[3];
+          dealii::Utilities::MPI::max(dealii::ArrayView<const double>(local, 3), communicator,
+                                      dealii::ArrayView<double>(global, 3));
+          max_speed         = global[0];
+          max_removed_speed = global[2];
+          AssertThrow(!parameters.pressure_averaging || global[1] < 1,
+                      dealii::ExcMessage("Parameter 'Solver/Pressure averaging': " + when + " a point moved to " +
+                                         dealii::Utilities::to_string(global[1]) +
+                                         " cells outside the cell it was sorted into, beyond the ghost cells "
+                                         "whose pressure sums are exchanged between ranks. Reduce 'Solver/CFL "
+                                         "number' or the time step."));
+          if (global[1] >= resort_at)
+            {
+              {
+                dealii::TimerOutput::Scope scope(timer, "migrate points");
+                engine->store(*points);
+                ++n_resorts;
+              }
+              if (balance())
+                engine->load(*points);
+            }
+        }
+      // A blow-up shows as a non-finite velocity or, with the adaptive step, as speeds that
+      // shrink dt by orders of magnitude: stop with a message instead of crawling on.
+      const double fastest = std::max(max_speed, max_removed_speed);
+      AssertThrow(std::isfinite(max_speed) && std::isfinite(max_removed_speed) && fastest <= 1000 * c_el,
+                  dealii::ExcMessage("The simulation became unstable " + when + ": a material point moves at " +
+                                     dealii::Utilities::to_string(fastest) +
+                                     " m/s, more than 1000 times the elastic wave speed. Reduce 'Solver/CFL "
+                                     "number' or the time step, or use GIMP shape functions."));
+    }
+
+    // Initial state/Equilibrate: damped steps at t = 0 with gravity in full until the points
+    // rest in the MPM's own equilibrium of the state given (time and step stay 0).
+    void equilibrate()
+    {
+      const auto started = std::chrono::steady_clock::now();
+      if (!plastic && 0 >= parameters.plasticity_start_time)
+        {
+          plastic = true;
+          for (auto &m : materials)
+            m.plasticity_enabled = true;
+          engine->set_materials(materials);
+        }
+      for (int d = 0; d < dim; ++d)
+        settings.gravity[d] = parameters.gravity[d];
+
+      PointSnapshot<dim> before;
+      engine->snapshot(before);
+      const HostPoints<dim, double> &p0 = before.points;
+      // The reference speed sqrt(|g| H), H the extent of the points' domains along gravity.
+      double g = 0;
+      for (int d = 0; d < dim; ++d)
+        g += parameters.gravity[d] * parameters.gravity[d];
+      g = std::sqrt(g);
+      double lowest = 1e300, highest = -1e300;
+      for (int i = 0; i < p0.size(); ++i)
+        if (p0.material[i] >= 0 && g > 0)
+          {
+            double along = 0, reach = 0;
+            for (int d = 0; d < dim; ++d)
+              {
+                along += p0.position[d][i] * parameters.gravity[d] / g;
+                reach += p0.domain_half_length[d][i] * std::abs(parameters.gravity[d]) / g;
+              }
+            lowest  = std::min(lowest, along - reach);
+            highest = std::max(highest, along + reach);
+          }
+      const double extent = g > 0 ? global_max(highest) + global_max(-lowest) : 0;
+      equilibration.reference_speed = g > 0 ? std::sqrt(g * extent) : c_el;
+      const double transit = (g > 0 ? extent : h) / c_el;
+
+      // Damped, PIC (FLIP would keep velocities the grid does not see, undamped for ever), and
+      // the points held in place: the equilibrium of the geometry given, not of one the points
+      // creep into (at a free surface a point whose domain just reaches a node's support feels
+      // that light node's large acceleration, and drifts).
+      const double damping = settings.damping, flip_fraction = settings.flip_fraction;
+      settings.damping       = parameters.equilibration_damping;
+      settings.flip_fraction = 0;
+      settings.hold_points   = true;
+      equilibrating        = true;
+      double calm          = 0; // how long the points have been at rest
+      while (calm < transit)
+        {
+          AssertThrow(equilibration.steps < long(parameters.equilibration_maximum_steps),
+                      dealii::ExcMessage(
+                        "Parameter 'Initial state/Equilibration maximum steps': after " +
+                        std::to_string(equilibration.steps) + " damped steps the largest point speed is still " +
+                        dealii::Utilities::to_string(max_speed / equilibration.reference_speed) +
+                        " sqrt(|g| H), above 'Initial state/Equilibration tolerance' (" +
+                        dealii::Utilities::to_string(parameters.equilibration_tolerance) +
+                        "). Either the state is not stable under these materials (it fails under its own "
+                        "weight), or it needs more steps: raise the maximum or the tolerance."));
+          const double dt = parameters.adaptive_time_step ? parameters.cfl * h / (c_el + max_speed) :
+                                                            parameters.fixed_time_step;
+          engine_step(dt);
+          ++equilibration.steps;
+          calm = max_speed < parameters.equilibration_tolerance * equilibration.reference_speed ? calm + dt : 0;
+        }
+      equilibrating             = false;
+      settings.damping          = damping;
+      settings.flip_fraction    = flip_fraction;
+      settings.hold_points      = false;
+      equilibration.final_speed = max_speed;
+
+      // How far it moved the stresses, point by point (by id: the engine may reorder them).
+      PointSnapshot<dim> after;
+      engine->snapshot(after);
+      std::unordered_map<dealii::types::particle_index, int> index;
+      for (int i = 0; i < p0.size(); ++i)
+        if (p0.material[i] >= 0)
+          index[before.labels->id[i]] = i;
+      const HostPoints<dim, double> &p1 = after.points;
+      double largest = 0, squares = 0, compared = 0;
+      for (int i = 0; i < p1.size(); ++i)
+        {
+          const auto found = index.find(after.labels->id[i]);
+          if (p1.material[i] < 0 || found == index.end())
+            continue;
+          const int j = found->second;
+          double change = 0;
+          for (int c = 0; c < n_voigt; ++c)
+            change = std::max(change, std::abs(p1.stress[c][i] - p0.stress[c][j]));
+          largest = std::max(largest, change);
+          squares += change * change;
+          compared += 1;
+        }
+      equilibration.max_stress_change = global_max(largest);
+      equilibration.rms_stress_change = std::sqrt(global_sum(squares) / std::max(1.0, global_sum(compared)));
+      equilibration.wall_seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+      pcout << "  equilibration: " << equilibration.steps << " damped steps (D = "
+            << parameters.equilibration_damping << ") in " << equilibration.wall_seconds
+            << " s; largest point speed at rest " << equilibration.final_speed << " m/s ("
+            << equilibration.final_speed / equilibration.reference_speed
+            << " sqrt(|g| H)); the stresses changed by up to " << equilibration.max_stress_change << " Pa (r.m.s. "
+            << equilibration.rms_stress_change << " Pa)" << std::endl;
     }
 
     void record_history()
@@ -518,6 +678,9 @@ namespace mpm
     s.settings.pressure_averaging = parameters.pressure_averaging;
     s.settings.mass_tolerance     = 1e-12 * s.m_min; // nodes lighter than that carry no velocity
 
+    if (parameters.equilibrate)
+      s.equilibrate();
+
     s.next_output   = parameters.output_interval;
     s.last_progress = std::chrono::steady_clock::now();
     s.set_up        = true;
@@ -566,49 +729,10 @@ namespace mpm
         s.pcout << "  plasticity switched on at t = " << s.time << " s" << std::endl;
       }
 
-    const StepReduction<double> r = s.timed("MPM step", [&]() { return s.engine->step(s.settings, dt); });
-    // One reduction for the next time step and the migration test: the largest
-    // speed and the largest distance of a point outside its home cell.
-    s.max_speed         = r.max_speed;
-    s.max_removed_speed = r.max_removed_speed;
-    if (s.parallel)
-      {
-        double local[3] = {r.max_speed, s.engine->max_distance_outside_home_cells(), r.max_removed_speed},
-               global[3];
-        dealii::Utilities::MPI::max(dealii::ArrayView<const double>(local, 3), s.communicator,
-                                    dealii::ArrayView<double>(global, 3));
-        s.max_speed         = global[0];
-        s.max_removed_speed = global[2];
-        AssertThrow(!parameters.pressure_averaging || global[1] < 1,
-                    dealii::ExcMessage("Parameter 'Solver/Pressure averaging': at t = " +
-                                       dealii::Utilities::to_string(s.time + dt) + " s a point moved to " +
-                                       dealii::Utilities::to_string(global[1]) +
-                                       " cells outside the cell it was sorted into, beyond the ghost cells "
-                                       "whose pressure sums are exchanged between ranks. Reduce 'Solver/CFL "
-                                       "number' or the time step."));
-        if (global[1] >= s.resort_at)
-          {
-            {
-              dealii::TimerOutput::Scope scope(s.timer, "migrate points");
-              s.engine->store(*s.points);
-              ++s.n_resorts;
-            }
-            if (s.balance())
-              s.engine->load(*s.points);
-          }
-      }
-    s.work_of_gravity += dt * s.global_sum(r.gravity_power);
+    s.engine_step(dt);
+    s.work_of_gravity += dt * s.global_sum(s.gravity_power);
     s.time += dt;
     ++s.step;
-    // A blow-up shows as a non-finite velocity or, with the adaptive step, as speeds that
-    // shrink dt by orders of magnitude: stop with a message instead of crawling on.
-    const double fastest = std::max(s.max_speed, s.max_removed_speed);
-    AssertThrow(std::isfinite(s.max_speed) && std::isfinite(s.max_removed_speed) && fastest <= 1000 * s.c_el,
-                dealii::ExcMessage("The simulation became unstable at t = " + dealii::Utilities::to_string(s.time) +
-                                   " s (step " + std::to_string(s.step) + "): a material point moves at " +
-                                   dealii::Utilities::to_string(fastest) +
-                                   " m/s, more than 1000 times the elastic wave speed. Reduce 'Solver/CFL "
-                                   "number' or the time step, or use GIMP shape functions."));
 
     if (s.step % parameters.history_every == 0)
       s.record_history();
@@ -705,6 +829,12 @@ namespace mpm
   long Simulator<dim>::step() const
   {
     return state->step;
+  }
+
+  template <int dim>
+  const EquilibrationReport &Simulator<dim>::equilibration() const
+  {
+    return state->equilibration;
   }
 
   template <int dim>

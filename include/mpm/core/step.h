@@ -52,6 +52,10 @@ namespace mpm
     // Cell-wise volume-weighted pressure averaging after the constitutive update
     // (remedy for volumetric locking); needs the grid's cell arrays.
     bool pressure_averaging = false;
+    // The points hold their place and shape (position, F, volume, GIMP domain): only their
+    // stresses follow the grid's velocities. The equilibration of an initial state uses it,
+    // so that the MPM's equilibrium is found in the geometry handed over.
+    bool hold_points = false;
   };
 
   // Per-step reductions over the points: the next time step needs the largest speed,
@@ -541,8 +545,9 @@ namespace mpm
 
         // The position first: x and dx are then dead before the constitutive update, the
         // largest live state of the kernel (the CUDA gathers run under a register cap).
-        bool leaves_grid = false;
-        if (move_points)
+        bool       leaves_grid = false;
+        const bool move        = move_points && !s.hold_points;
+        if (move)
           for (int d = 0; d < dim; ++d)
             {
               const Real xn      = x[d] + dt * dx[d];
@@ -569,15 +574,18 @@ namespace mpm
             const SymTensor<Real> d_eps = symmetric_part(Ldt);
 
             // F <- (I + L dt) F; the volume follows det F.
-            Mat3<Real> F = Mat3<Real>::identity();
-            for (int a = 0; a < dim; ++a)
-              for (int b = 0; b < dim; ++b)
-                F.a[a][b] = p.deformation_gradient[a * dim + b][i];
-            F = multiply(dF, F);
-            for (int a = 0; a < dim; ++a)
-              for (int b = 0; b < dim; ++b)
-                p.deformation_gradient[a * dim + b][i] = F.a[a][b];
-            p.volume[i] = p.initial_volume[i] * determinant(F);
+            if (!s.hold_points)
+              {
+                Mat3<Real> F = Mat3<Real>::identity();
+                for (int a = 0; a < dim; ++a)
+                  for (int b = 0; b < dim; ++b)
+                    F.a[a][b] = p.deformation_gradient[a * dim + b][i];
+                F = multiply(dF, F);
+                for (int a = 0; a < dim; ++a)
+                  for (int b = 0; b < dim; ++b)
+                    p.deformation_gradient[a * dim + b][i] = F.a[a][b];
+                p.volume[i] = p.initial_volume[i] * determinant(F);
+              }
             MaterialPointState<Real> state;
             for (int c = 0; c < n_voigt; ++c)
               state.stress[c] = p.stress[c][i];
@@ -595,7 +603,7 @@ namespace mpm
             p.plastic_strain[i] = state.plastic_strain;
           }
 
-        if (s.domain_update != DomainUpdate::none && move_points)
+        if (s.domain_update != DomainUpdate::none && move)
           {
             const Real J     = p.volume[i] / p.initial_volume[i];
             const Real iso   = dim == 2 ? std::sqrt(J) : std::cbrt(J);

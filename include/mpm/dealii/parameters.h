@@ -97,6 +97,11 @@ namespace mpm
     std::string  fem_placement = "quadrature points"; // or "lattice"
     unsigned int fem_points_per_direction = 2;
     int          fem_projection_degree    = -1;
+    // Damped steps at t = 0 until the points rest in the MPM's own equilibrium (Simulator)
+    bool         equilibrate                 = false;
+    double       equilibration_damping       = 0.8;
+    double       equilibration_tolerance     = 1e-6; // largest point speed / sqrt(|g| H)
+    unsigned int equilibration_maximum_steps = 100000;
     // FEM material_id -> (index into materials, density)
     std::map<unsigned int, std::pair<unsigned int, double>> fem_materials;
 

@@ -24,6 +24,20 @@
 
 namespace mpm
 {
+  // What setup()'s equilibration did (Initial state/Equilibrate): damped steps at t = 0,
+  // gravity in full, the points held in place, until the grid's velocities vanish: the
+  // stresses then balance gravity in the MPM's own discretisation of the geometry given.
+  // And how far that moved the stresses. steps = 0: no equilibration.
+  struct EquilibrationReport
+  {
+    long   steps           = 0;
+    double wall_seconds    = 0;
+    double reference_speed = 0; // sqrt(|g| H), H the points' extent along gravity (m/s)
+    double final_speed     = 0; // largest point speed at the end (m/s)
+    double max_stress_change = 0; // largest change of a stress component of a point (Pa)
+    double rms_stress_change = 0; // root mean square over the points of their largest change (Pa)
+  };
+
   template <int dim>
   class Simulator
   {
@@ -32,8 +46,9 @@ namespace mpm
     // Waits for output still being written; prints the timing summary.
     ~Simulator();
 
-    // Builds the background grid, the material points and the engine (Backend), and writes
-    // the t = 0 output and history row. Throws naming the parameter on bad input.
+    // Builds the background grid, the material points and the engine (Backend), equilibrates
+    // the points where Initial state/Equilibrate asks for it, and writes the t = 0 output and
+    // history row. Throws naming the parameter on bad input.
     void setup();
     // The same with the points of `bodies` instead of the prm's bodies (Material points): a
     // state handed over from elsewhere, e.g. an FEM analysis (fem_handover.h). Every point
@@ -56,6 +71,8 @@ namespace mpm
 
     double time() const;
     long   step() const;
+    // The equilibration's numbers (steps = 0 where Initial state/Equilibrate is false).
+    const EquilibrationReport &equilibration() const;
     const Parameters &parameters() const;
 
     // The material points as the engine holds them now, in the engine's order; points that
