@@ -193,10 +193,12 @@ namespace mpm
       gravity_power     = r.gravity_power;
       max_speed         = r.max_speed;
       max_removed_speed = r.max_removed_speed;
-      const std::string when =
-        equilibrating ? "in damped step " + std::to_string(equilibration.steps + 1) + " of the equilibration" :
-                        "at t = " + dealii::Utilities::to_string(time + dt) + " s (step " +
-                          std::to_string(step + 1) + ")";
+      // Where a message says the step was; built only for a message (a string per step costs).
+      const auto when = [&]() {
+        return equilibrating ?
+                 "in damped step " + std::to_string(equilibration.steps + 1) + " of the equilibration" :
+                 "at t = " + dealii::Utilities::to_string(time + dt) + " s (step " + std::to_string(step + 1) + ")";
+      };
       if (parallel)
         {
           // One reduction for the next time step and the migration test: the largest
@@ -208,7 +210,7 @@ namespace mpm
           max_speed         = global[0];
           max_removed_speed = global[2];
           AssertThrow(!parameters.pressure_averaging || global[1] < 1,
-                      dealii::ExcMessage("Parameter 'Solver/Pressure averaging': " + when + " a point moved to " +
+                      dealii::ExcMessage("Parameter 'Solver/Pressure averaging': " + when() + " a point moved to " +
                                          dealii::Utilities::to_string(global[1]) +
                                          " cells outside the cell it was sorted into, beyond the ghost cells "
                                          "whose pressure sums are exchanged between ranks. Reduce 'Solver/CFL "
@@ -228,7 +230,7 @@ namespace mpm
       // shrink dt by orders of magnitude: stop with a message instead of crawling on.
       const double fastest = std::max(max_speed, max_removed_speed);
       AssertThrow(std::isfinite(max_speed) && std::isfinite(max_removed_speed) && fastest <= 1000 * c_el,
-                  dealii::ExcMessage("The simulation became unstable " + when + ": a material point moves at " +
+                  dealii::ExcMessage("The simulation became unstable " + when() + ": a material point moves at " +
                                      dealii::Utilities::to_string(fastest) +
                                      " m/s, more than 1000 times the elastic wave speed. Reduce 'Solver/CFL "
                                      "number' or the time step, or use GIMP shape functions."));
