@@ -118,8 +118,8 @@ namespace mpm
     double balanced  = 1; // imbalance right after the last repartition: what p4est achieves
 
     double time = 0, max_speed = 0, max_removed_speed = 0, work_of_gravity = 0, dt = 0, gravity_power = 0;
-    bool                  equilibrating = false;
-    EquilibrationReport   equilibration;
+    bool                equilibrating = false;
+    EquilibrationReport equilibration;
     long   step = 0, n_removed = 0;
     double next_output = 0;
     std::chrono::steady_clock::time_point last_progress;
@@ -184,6 +184,18 @@ namespace mpm
       return true;
     }
 
+    // Plastic models answer elastically until Solver/Plasticity start time.
+    void switch_plasticity_on_when_due()
+    {
+      if (plastic || time < parameters.plasticity_start_time)
+        return;
+      plastic = true;
+      for (auto &m : materials)
+        m.plasticity_enabled = true;
+      engine->set_materials(materials);
+      pcout << "  plasticity switched on at t = " << time << " s" << std::endl;
+    }
+
     // One step of the engine with the current settings, and what every step needs after it:
     // the largest speeds over the ranks, the MPI re-sort when points have strayed, the
     // stability check. Time and step counters are the caller's.
@@ -241,13 +253,7 @@ namespace mpm
     void equilibrate()
     {
       const auto started = std::chrono::steady_clock::now();
-      if (!plastic && 0 >= parameters.plasticity_start_time)
-        {
-          plastic = true;
-          for (auto &m : materials)
-            m.plasticity_enabled = true;
-          engine->set_materials(materials);
-        }
+      switch_plasticity_on_when_due(); // the materials as the first step will have them
       for (int d = 0; d < dim; ++d)
         settings.gravity[d] = parameters.gravity[d];
 
@@ -284,8 +290,8 @@ namespace mpm
       settings.damping       = parameters.equilibration_damping;
       settings.flip_fraction = 0;
       settings.hold_points   = true;
-      equilibrating        = true;
-      double calm          = 0; // how long the points have been at rest
+      equilibrating          = true;
+      double calm            = 0; // how long the points have been at rest
       while (calm < transit)
         {
           AssertThrow(equilibration.steps < long(parameters.equilibration_maximum_steps),
@@ -722,15 +728,7 @@ namespace mpm
     for (int d = 0; d < dim; ++d)
       s.settings.gravity[d] = ramp * parameters.gravity[d];
 
-    if (!s.plastic && s.time >= parameters.plasticity_start_time)
-      {
-        s.plastic = true;
-        for (auto &m : s.materials)
-          m.plasticity_enabled = true;
-        s.engine->set_materials(s.materials);
-        s.pcout << "  plasticity switched on at t = " << s.time << " s" << std::endl;
-      }
-
+    s.switch_plasticity_on_when_due();
     s.engine_step(dt);
     s.work_of_gravity += dt * s.global_sum(s.gravity_power);
     s.time += dt;

@@ -30,10 +30,10 @@ namespace mpm
   // And how far that moved the stresses. steps = 0: no equilibration.
   struct EquilibrationReport
   {
-    long   steps           = 0;
-    double wall_seconds    = 0;
-    double reference_speed = 0; // sqrt(|g| H), H the points' extent along gravity (m/s)
-    double final_speed     = 0; // largest point speed at the end (m/s)
+    long   steps             = 0; // damped steps taken
+    double wall_seconds      = 0;
+    double reference_speed   = 0; // sqrt(|g| H), H the extent of the points' domains along gravity (m/s)
+    double final_speed       = 0; // largest point speed at the end (m/s), below tolerance x reference_speed
     double max_stress_change = 0; // largest change of a stress component of a point (Pa)
     double rms_stress_change = 0; // root mean square over the points of their largest change (Pa)
   };
