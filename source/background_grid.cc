@@ -5,10 +5,19 @@
 #include <deal.II/dofs/dof_tools.h>
 #include <deal.II/grid/grid_generator.h>
 
+#include <algorithm>
 #include <cmath>
 
 namespace mpm
 {
+  namespace
+  {
+    bool has_friction_face(const std::array<BoundaryType, 6> &boundary)
+    {
+      return std::find(boundary.begin(), boundary.end(), BoundaryType::friction) != boundary.end();
+    }
+  } // namespace
+
   template <int dim>
   HostGrid<dim, double> lattice_geometry(const Parameters &parameters)
   {
@@ -29,8 +38,16 @@ namespace mpm
     HostGrid<dim, double>       grid;
     grid.make_dense(lattice.origin, lattice.h, lattice.n_cells);
     // A node on face id (x min, x max, y min, ...) takes that face's mask: no-slip fixes
-    // every component, free-slip the normal one; edges and corners combine their faces'.
+    // every component, free-slip the normal one, friction sets bit id of its friction
+    // mask; edges and corners combine their faces'.
     const long n_nodes = static_cast<long>(grid.mass.size());
+    if (has_friction_face(parameters.boundary))
+      {
+        grid.friction_faces.assign(n_nodes, 0);
+        for (unsigned int id = 0; id < 2 * dim; ++id)
+          grid.friction_coefficient[id] =
+            parameters.boundary[id] == BoundaryType::friction ? parameters.friction_coefficient : 0.0;
+      }
     for (long l = 0; l < n_nodes; ++l)
       {
         long          rest = l;
@@ -48,6 +65,8 @@ namespace mpm
                   mask |= std::uint8_t((1u << dim) - 1);
                 else if (type == BoundaryType::free_slip)
                   mask |= std::uint8_t(1u << d);
+                else if (type == BoundaryType::friction)
+                  grid.friction_faces[l] |= std::uint8_t(1u << id);
               }
           }
       }
@@ -66,6 +85,9 @@ namespace mpm
     , dof_handler(triangulation)
     , boundary(parameters.boundary)
   {
+    if (has_friction_face(parameters.boundary))
+      for (unsigned int id = 0; id < 2 * dim; ++id)
+        friction_coefficient[id] = boundary[id] == BoundaryType::friction ? parameters.friction_coefficient : 0.0;
     const HostGrid<dim, double> lattice = lattice_geometry<dim>(parameters);
     h = lattice.h;
     std::vector<unsigned int> repetitions(dim);
@@ -120,6 +142,7 @@ namespace mpm
     const unsigned int n_local_nodes = partitioner->locally_owned_size() + partitioner->n_ghost_indices();
     lattice_to_node.assign(n_lattice_nodes, -1);
     fixed_components.assign(n_local_nodes, 0);
+    friction_faces.assign(has_friction_face(boundary) ? n_local_nodes : 0, 0);
     cell_of_lattice_cell.assign(n_lattice_cells, triangulation.end());
 
     auto lattice_index = [&](const dealii::Point<dim> &x, const bool of_cell) {
@@ -156,9 +179,10 @@ namespace mpm
             lattice_to_node[lattice_index(cell->vertex(v), false)] =
               static_cast<int>(partitioner->global_to_local(global));
           }
-        // Boundary masks from the face ids: no-slip fixes every component, free-slip the normal one.
-        // Every cell touching a boundary node has a face with that node on that boundary, so ghost
-        // nodes get the same mask as on their owner.
+        // Boundary masks from the face ids: no-slip fixes every component, free-slip the normal one,
+        // friction marks the face in the node's friction mask. Every cell touching a boundary node
+        // has a face with that node on that boundary, so ghost nodes get the same masks as on their
+        // owner.
         for (const unsigned int f : cell->face_indices())
           if (cell->face(f)->at_boundary())
             {
@@ -167,11 +191,14 @@ namespace mpm
               if (type == BoundaryType::free)
                 continue;
               const std::uint8_t bits = type == BoundaryType::no_slip ? std::uint8_t((1u << dim) - 1) :
-                                                                       std::uint8_t(1u << (id / 2));
+                                        type == BoundaryType::free_slip ? std::uint8_t(1u << (id / 2)) :
+                                                                          std::uint8_t(0);
               for (unsigned int fv = 0; fv < dealii::GeometryInfo<dim>::vertices_per_face; ++fv)
                 {
-                  const auto global = cell->face(f)->vertex_dof_index(fv, 0);
-                  fixed_components[partitioner->global_to_local(global)] |= bits;
+                  const auto node = partitioner->global_to_local(cell->face(f)->vertex_dof_index(fv, 0));
+                  fixed_components[node] |= bits;
+                  if (type == BoundaryType::friction)
+                    friction_faces[node] |= std::uint8_t(1u << id);
                 }
             }
       }
@@ -213,6 +240,12 @@ namespace mpm
     v.n_nodes          = static_cast<int>(fixed_components.size());
     v.mass             = mass.begin();
     v.fixed_components = fixed_components.data();
+    if (!friction_faces.empty())
+      {
+        v.friction_faces = friction_faces.data();
+        for (unsigned int id = 0; id < 2 * dim; ++id)
+          v.friction_coefficient[id] = friction_coefficient[id];
+      }
     return v;
   }
 

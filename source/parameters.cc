@@ -93,11 +93,17 @@ namespace mpm
     for (unsigned int d = 0; d < dim; ++d)
       for (const std::string side : {"min", "max"})
         prm.declare_entry(std::string(axis_names[d]) + " " + side, "free",
-                          Patterns::Selection("free|no-slip|free-slip"),
+                          Patterns::Selection("free|no-slip|free-slip|friction"),
                           std::string("Condition on the grid face ") + axis_names[d] + " = " + side +
                             " (boundary id " + std::to_string(2 * d + (side == std::string("max"))) +
-                            "): free, no-slip (all velocity components zero) or free-slip (roller: normal "
-                            "component zero).");
+                            "): free, no-slip (all velocity components zero), free-slip (roller: normal "
+                            "component zero) or friction (normal component zero, Coulomb friction with "
+                            "the Friction coefficient on the tangential velocity).");
+    prm.declare_entry("Friction coefficient", "0", Patterns::Double(0),
+                      "Coulomb friction coefficient mu of every face set to friction: where material presses "
+                      "on the wall, the tangential velocity of a wall node is reduced by mu times its normal "
+                      "velocity into the wall, to rest at most. Must be > 0 where a face is friction "
+                      "(mu = 0 is free-slip).");
     prm.leave_subsection();
 
     prm.enter_subsection("Solver");
@@ -335,9 +341,17 @@ namespace mpm
       for (unsigned int side = 0; side < 2; ++side)
         {
           const std::string v = prm.get(std::string(axis_names[d]) + (side ? " max" : " min"));
-          boundary[2 * d + side] =
-            v == "no-slip" ? BoundaryType::no_slip : (v == "free-slip" ? BoundaryType::free_slip : BoundaryType::free);
+          boundary[2 * d + side] = v == "no-slip"   ? BoundaryType::no_slip :
+                                   v == "free-slip" ? BoundaryType::free_slip :
+                                   v == "friction"  ? BoundaryType::friction :
+                                                      BoundaryType::free;
         }
+    friction_coefficient = prm.get_double("Friction coefficient");
+    for (unsigned int id = 0; id < 2 * dim; ++id)
+      if (boundary[id] == BoundaryType::friction && !(friction_coefficient > 0))
+        fail("Boundary conditions/Friction coefficient",
+             std::string("must be > 0 where a face is friction (") + axis_names[id / 2] + (id % 2 ? " max" : " min") +
+               " is); for a wall without friction set that face to free-slip.");
     prm.leave_subsection();
 
     prm.enter_subsection("Solver");

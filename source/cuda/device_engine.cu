@@ -174,6 +174,14 @@ namespace mpm
           host.lattice_to_node = lattice_nodes;
           host.fixed_components.assign(g.fixed_components, g.fixed_components + g.n_nodes);
         }
+      if (g.friction_faces != nullptr)
+        {
+          host.friction_faces.resize(g.n_nodes);
+          for (int n = 0; n < g.n_nodes; ++n)
+            host.friction_faces[n] = g.friction_faces[bijection ? lattice_nodes[n] : n];
+          for (int f = 0; f < 2 * dim; ++f)
+            host.friction_coefficient[f] = g.friction_coefficient[f];
+        }
       impl->grid.upload(host);
       impl->materials.upload(materials);
       impl->exchange = ExchangeAdapter{exchange, g.n_nodes};

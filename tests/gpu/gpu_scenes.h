@@ -6,6 +6,9 @@
 //             and base
 //   collapse: V3 geometry (2D, 0.2 m x 0.1 m column against a wall), h = 5 mm, 2x2 ppc,
 //             elastic or Drucker-Prager; no-slip base, rollers on walls, gravity applied at once
+//   slide   : 3D elastic block (0.4 x 0.3 x 0.2 m, h = 5 cm, 1,536 points, geostatic stress)
+//             thrown at (2, 1, 0) m/s over a frictional base (mu = 0.3) against a frictional
+//             wall at x max (mu = 0.5) that it reaches after about 0.07 s
 #pragma once
 
 #include "../../benchmarks/p1_scene.h"
@@ -121,6 +124,68 @@ namespace mpm_test
         const double dt = cfl * h / (c + max_speed);
         const auto pv = target.template points_at_step<GimpShape>(r.n_steps);
         max_speed = explicit_step<2, GimpShape>(target.backend, gv, pv, target.material_table(), s, dt).max_speed;
+        r.time += dt;
+      }
+    target.finish();
+    return r;
+  }
+
+  // The slide: frictional walls (wall_friction.h) on the base and on the wall it runs into.
+  template <template <int, typename> class Target>
+  SceneResult slide(mpm::HostPoints<3, double> &points, const long n_steps,
+                    const mpm::HostPoints<3, double> *initial = nullptr)
+  {
+    using namespace mpm;
+    const double h = 0.05, rho = 2000, E = 1e7, nu = 0.3, g = 9.81, cfl = 0.5, height = 0.2;
+    HostGrid<3, double> grid;
+    const double        lower[3] = {0, 0, 0};
+    const int           cells[3] = {20, 16, 8};
+    grid.make_dense(lower, h, cells);
+    grid.friction_faces.assign(grid.mass.size(), 0);
+    grid.friction_coefficient[1] = 0.5; // x max
+    grid.friction_coefficient[4] = 0.3; // z min
+    for (long n = 0; n < long(grid.lattice_to_node.size()); ++n)
+      {
+        int idx[3];
+        grid.lattice_coordinates(n, idx);
+        grid.friction_faces[n] = (idx[0] == cells[0] ? 1u << 1 : 0u) | (idx[2] == 0 ? 1u << 4 : 0u);
+      }
+    points = HostPoints<3, double>();
+    BodyDescription<3, double> body{2, rho, {2, 1, 0}, 0};
+    const double               lo[3] = {0.45, 0.1, 0}, hi[3] = {0.85, 0.4, height};
+    add_points(points, grid, lo, hi, body, [](const double *) { return true; });
+    const double k0 = nu / (1 - nu);
+    for (int i = 0; i < points.size(); ++i)
+      {
+        points.stress[2][i] = -rho * g * (height - points.position[2][i]);
+        points.stress[0][i] = points.stress[1][i] = k0 * points.stress[2][i];
+      }
+    if (initial != nullptr)
+      points = *initial;
+    MaterialParameters<double> m;
+    m.model                  = MaterialModel::linear_elastic;
+    m.elastic.youngs_modulus = E;
+    m.elastic.poissons_ratio = nu;
+    const double c           = std::sqrt(m.elastic.p_wave_modulus() / rho);
+
+    StepSettings<3, double> s;
+    s.scheme         = UpdateScheme::musl;
+    s.gravity[0]     = 0;
+    s.gravity[1]     = 0;
+    s.gravity[2]     = -g;
+    s.damping        = 0;
+    s.flip_fraction  = 1.0;
+    s.domain_update  = DomainUpdate::det_F;
+    s.mass_tolerance = 1e-12 * points.mass[0];
+    Target<3, double> target(grid, points, {m});
+    auto              gv = target.grid();
+    SceneResult       r;
+    double            max_speed = 0;
+    for (; r.n_steps < n_steps; ++r.n_steps)
+      {
+        const double dt = cfl * h / (c + max_speed);
+        const auto   pv = target.template points_at_step<GimpShape>(r.n_steps);
+        max_speed = explicit_step<3, GimpShape>(target.backend, gv, pv, target.material_table(), s, dt).max_speed;
         r.time += dt;
       }
     target.finish();

@@ -34,6 +34,9 @@
 // Drucker-Prager scenes are held like the damped ones: the choice between the elastic,
 // shear, tension and corner returns switches on inequalities, so a point at a switch
 // follows the order of the sums.
+// Frictional walls are held like the damped scenes too: the friction acts only where a wall
+// node moves into the wall, and stops the tangential velocity at zero at most, two switches
+// that a node at the switch takes either way.
 // Only GIMP is compared: its weights are C1 in the point position, so a perturbation of a
 // position changes the weights by as much; standard MPM's gradients jump at cell faces.
 #include "../core/check.h"
@@ -186,6 +189,24 @@ int main()
         slump<CudaSortedTarget>(2, gpu, n, &initial, damping, true, norm, threshold);
         report<3>("P1/V5 slump, DP, GPU sorted every 7, D=0.1 force norm", compare_points(cpu, gpu, mpm_bench::P1::h),
                   spread, n, true);
+      }
+      {
+        // A 3D block sliding over a frictional base into a frictional wall, 400 steps
+        const long            n = 400;
+        HostPoints<3, double> cpu, gpu, initial;
+        slide<CpuTarget>(initial, 0);
+        const SceneResult run = slide<CpuTarget>(cpu, n, &initial);
+        double            x_max = 0;
+        for (int i = 0; i < cpu.size(); ++i)
+          x_max = std::max(x_max, cpu.position[0][i]);
+        std::printf("slide: after %.3f s the block's front is at x = %.4f m (the wall at 1 m)\n", run.time, x_max);
+        check(x_max > 0.97, "slide: the block has reached the frictional wall");
+        const Difference spread = cpu_reordering_spread(
+          initial, cpu, 0.05, [&](auto &out, const auto *start) { slide<CpuTarget>(out, n, start); });
+        slide<CudaTarget>(gpu, n, &initial);
+        report<3>("3D slide, frictional base and wall", compare_points(cpu, gpu, 0.05), spread, n, true);
+        slide<CudaSortedTarget>(gpu, n, &initial);
+        report<3>("3D slide, GPU sorted every 7", compare_points(cpu, gpu, 0.05), spread, n, true);
       }
       for (const double damping : {0.0, mpm_bench::P1::damping})
         {

@@ -123,6 +123,12 @@ namespace mpm
     v.n_nodes          = static_cast<int>(s.mass.size());
     v.mass             = s.mass.data();
     v.fixed_components = s.fixed_components.data();
+    if (s.friction_faces.size() > 0)
+      {
+        v.friction_faces = s.friction_faces.data();
+        for (int f = 0; f < 2 * dim; ++f)
+          v.friction_coefficient[f] = s.friction_coefficient[f];
+      }
     if (s.cell_volume.size() > 0)
       {
         v.cell_volume          = s.cell_volume.data();
@@ -140,6 +146,8 @@ namespace mpm
     std::vector<int>          lattice_to_node;
     std::vector<Real>         mass, momentum[dim], force[dim], velocity[dim];
     std::vector<std::uint8_t> fixed_components;
+    std::vector<std::uint8_t> friction_faces;                    // empty: no frictional wall (views.h)
+    Real                      friction_coefficient[2 * dim] = {}; // mu of each grid face
     std::vector<Real>         cell_volume, cell_pressure_volume; // pressure-averaging scratch, one per lattice cell
 
     // A dense grid whose node numbering is the lattice numbering (standalone use).

@@ -15,6 +15,7 @@
 #include <mpm/core/shape_functions.h>
 #include <mpm/core/small_tensor.h>
 #include <mpm/core/views.h>
+#include <mpm/core/wall_friction.h>
 
 #include <cmath>
 #include <stdexcept>
@@ -333,6 +334,13 @@ namespace mpm
               f[d] = g.force[d][n];
             norm = local_damping_norm<dim>(f, s.damping_form);
           }
+        // A node on a frictional wall keeps its velocity before the update, from which the
+        // wall's correction of the new velocity gives the acceleration FLIP needs.
+        const std::uint8_t faces = g.friction_faces != nullptr && m > s.mass_tolerance ? g.friction_faces[n] : 0;
+        Real               v_old[dim];
+        if (faces != 0)
+          for (int d = 0; d < dim; ++d)
+            v_old[d] = (g.fixed_components[n] >> d) & 1u ? Real(0) : g.momentum[d][n] / m;
         for (int d = 0; d < dim; ++d)
           {
             const bool fixed = (g.fixed_components[n] >> d) & 1u;
@@ -350,20 +358,39 @@ namespace mpm
             g.velocity[d][n] = v_new;
             g.force[d][n]    = s.flip_fraction * (dt * (f / m)) + (Real(1) - s.flip_fraction) * v_new;
           }
+        if (faces != 0)
+          {
+            Real v[dim];
+            for (int d = 0; d < dim; ++d)
+              v[d] = g.velocity[d][n];
+            apply_wall_friction<dim>(v, faces, g.friction_coefficient);
+            for (int d = 0; d < dim; ++d)
+              {
+                g.momentum[d][n] = zero_momentum ? Real(0) : m * v[d];
+                g.velocity[d][n] = v[d];
+                g.force[d][n]    = s.flip_fraction * (v[d] - v_old[d]) + (Real(1) - s.flip_fraction) * v[d];
+              }
+          }
       });
     }
 
-    // Nodal velocity from nodal momentum, boundary masks re-imposed.
+    // Nodal velocity from nodal momentum, boundary masks re-imposed; on a frictional wall
+    // only the contact (the friction acted in the grid update, and the remap carries it).
     template <int dim, typename Real, typename Backend>
     void velocity_from_momentum(Backend &backend, const GridView<dim, Real> &g, const Real mass_tolerance)
     {
       backend.for_each_node(g.n_nodes, [=] MPM_HOST_DEVICE(const int n) {
         const Real m = g.mass[n];
+        Real       v[dim];
         for (int d = 0; d < dim; ++d)
           {
             const bool fixed = (g.fixed_components[n] >> d) & 1u;
-            g.velocity[d][n] = (m <= mass_tolerance || fixed) ? Real(0) : g.momentum[d][n] / m;
+            v[d]             = (m <= mass_tolerance || fixed) ? Real(0) : g.momentum[d][n] / m;
           }
+        if (g.friction_faces != nullptr)
+          apply_wall_contact<dim>(v, g.friction_faces[n]);
+        for (int d = 0; d < dim; ++d)
+          g.velocity[d][n] = v[d];
       });
     }
 

@@ -29,6 +29,10 @@ namespace mpm
     Real *force[dim];    // force; after the grid update, the nodal part of G2P's velocity (update_grid)
     Real *velocity[dim]; // nodal velocity used by G2P kinematics
     const std::uint8_t *fixed_components; // bit d set: velocity component d is prescribed zero
+    // Frictional walls (wall_friction.h): bit f set where the node lies on grid face f
+    // (x min, x max, y min, ...) and that face's wall is frictional. Null: no such face.
+    const std::uint8_t *friction_faces = nullptr;
+    Real                friction_coefficient[2 * dim] = {}; // mu of each face
 
     // Per-cell scratch sums of the optional cell pressure averaging (step.h), one entry
     // per lattice cell, indexed like lattice_cell(). Null where the owner of the grid

@@ -136,6 +136,8 @@ namespace mpm
     std::array<BoundaryType, 6> boundary;
     std::vector<int>          lattice_to_node;
     std::vector<std::uint8_t> fixed_components;
+    std::vector<std::uint8_t> friction_faces;            // empty without a friction face
+    double                    friction_coefficient[6] = {}; // by boundary id
     std::vector<typename dealii::Triangulation<dim>::active_cell_iterator> cell_of_lattice_cell;
 
     // Scratch of the exchange: import/export buffers and MPI requests per array.

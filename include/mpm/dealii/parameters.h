@@ -21,7 +21,8 @@ namespace mpm
   {
     free,      // no constraint
     no_slip,   // every velocity component zero
-    free_slip  // normal velocity component zero (roller)
+    free_slip, // normal velocity component zero (roller)
+    friction   // normal velocity component zero, Coulomb friction on the tangential (wall_friction.h)
   };
 
   struct BodyParameters
@@ -45,6 +46,7 @@ namespace mpm
     std::vector<double> lower, upper;
     double              cell_size;
     std::array<BoundaryType, 6> boundary{}; // by boundary id: x min, x max, y min, y max, z min, z max
+    double                      friction_coefficient = 0; // mu of every face of type friction
 
     // Solver
     double       end_time;

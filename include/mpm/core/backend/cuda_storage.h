@@ -123,6 +123,8 @@ namespace mpm
     DeviceArray<int>          lattice_to_node;
     DeviceArray<Real>         mass, momentum[dim], force[dim], velocity[dim];
     DeviceArray<std::uint8_t> fixed_components;
+    DeviceArray<std::uint8_t> friction_faces; // empty: no frictional wall
+    Real                      friction_coefficient[2 * dim] = {};
     DeviceArray<Real>         cell_volume, cell_pressure_volume; // pressure averaging; empty unless resized
 
     int n_nodes() const { return static_cast<int>(mass.size()); }
@@ -145,6 +147,9 @@ namespace mpm
         lattice_order = g.lattice_to_node[l] == static_cast<int>(l);
       mass.upload(g.mass);
       fixed_components.upload(g.fixed_components);
+      friction_faces.upload(g.friction_faces);
+      for (int f = 0; f < 2 * dim; ++f)
+        friction_coefficient[f] = g.friction_coefficient[f];
     }
 
     // Nodal values back to the host (tests, output).
