@@ -112,6 +112,8 @@ namespace mpm
           const int first  = body.shape == "polygon" ? 1 : 0;
           for (int d = first; d < dim - 1; ++d)
             covers = covers && body.lower[d] <= x[d] && x[d] <= body.upper[d];
+          if (body.shape == "cylinder")
+            covers = covers && std::hypot(x[0] - body.axis[0], x[1] - body.axis[1]) <= body.radius;
           if (!covers)
             continue;
           const double thickness =
@@ -178,6 +180,8 @@ namespace mpm
           }
         HostPoints<dim, double> &points = bodies[b].points;
         add_points(points, lattice, lower, upper, description, [&](const double *x) {
+          if (body.shape == "cylinder")
+            return std::hypot(x[0] - body.axis[0], x[1] - body.axis[1]) <= body.radius;
           return body.shape != "polygon" || inside_polygon(px, pv, x[0], x[dim - 1]);
         });
 

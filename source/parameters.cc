@@ -187,10 +187,12 @@ namespace mpm
     for (unsigned int b = 1; b <= n_bodies; ++b)
       {
         prm.enter_subsection("Body " + std::to_string(b));
-        prm.declare_entry("Shape", "box", Patterns::Selection("box|polygon"),
+        prm.declare_entry("Shape", "box", Patterns::Selection("box|polygon|cylinder"),
                           "box: the points fill [Lower corner, Upper corner]. polygon: the points fill the polygon "
                           "given by 'Polygon vertices' in the (x, vertical) plane; in 3D it is extruded along y "
-                          "between the y coordinates of Lower and Upper corner.");
+                          "between the y coordinates of Lower and Upper corner. cylinder (3D only): the points of "
+                          "the box [Lower corner, Upper corner] within 'Radius' of the vertical line through "
+                          "'Cylinder axis' (a column, or the quarter of one cut by the box).");
         prm.declare_entry("Lower corner", zeros(dim), point_pattern(dim), "Lower corner of the box (m).");
         prm.declare_entry("Upper corner", ones(dim), point_pattern(dim), "Upper corner of the box (m).");
         prm.declare_entry("Polygon vertices", "",
@@ -198,6 +200,9 @@ namespace mpm
                                          Patterns::List::max_int_value, ";"),
                           "Vertices 'x1, v1; x2, v2; ...' of the polygon (at least 3), v the vertical "
                           "coordinate (y in 2D, z in 3D).");
+        prm.declare_entry("Cylinder axis", "0, 0", Patterns::List(Patterns::Double(), 2, 2, ","),
+                          "Shape = cylinder: the horizontal coordinates 'x, y' of the cylinder's vertical axis (m).");
+        prm.declare_entry("Radius", "0", Patterns::Double(0), "Shape = cylinder: its radius (m), > 0.");
         prm.declare_entry("Points per cell direction", "2", Patterns::Integer(1, 10),
                           "Material points per cell along each direction (2 gives 2x2 in 2D, 2x2x2 in 3D).");
         prm.declare_entry("Density", "1000", Patterns::Double(0), "Mass density (kg/m^3, > 0).");
@@ -521,6 +526,12 @@ namespace mpm
             const auto xy = dealii::Utilities::string_to_double(dealii::Utilities::split_string_list(vertex, ','));
             body.polygon.push_back({{xy[0], xy[1]}});
           }
+        {
+          const auto axis = dealii::Utilities::string_to_double(
+            dealii::Utilities::split_string_list(prm.get("Cylinder axis"), ','));
+          body.axis   = {{axis[0], axis[1]}};
+          body.radius = prm.get_double("Radius");
+        }
         body.points_per_direction = prm.get_integer("Points per cell direction");
         body.density              = prm.get_double("Density");
         body.velocity             = get_point(prm, "Initial velocity");
@@ -538,6 +549,10 @@ namespace mpm
         if (material_index == material_names.size())
           fail(where + "Material", "'" + body.material + "' is not one of Materials/Names (allowed: " +
                                      join(material_names) + ").");
+        if (body.shape == "cylinder" && dim != 3)
+          fail(where + "Shape", "a cylinder (a vertical column) needs Dimension = 3; in 2D use box or polygon.");
+        if (body.shape == "cylinder" && !(body.radius > 0))
+          fail(where + "Radius", "a cylinder needs a radius > 0.");
         if (body.shape == "polygon" && body.polygon.size() < 3)
           fail(where + "Polygon vertices", "a polygon needs at least 3 vertices, got " +
                                              std::to_string(body.polygon.size()) + ".");

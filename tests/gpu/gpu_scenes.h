@@ -8,7 +8,7 @@
 //             elastic or Drucker-Prager; no-slip base, rollers on walls, gravity applied at once
 //   slide   : 3D elastic block (0.4 x 0.3 x 0.2 m, h = 5 cm, 1,536 points, geostatic stress)
 //             thrown at (2, 1, 0) m/s over a frictional base (mu = 0.3) against a frictional
-//             wall at x max (mu = 0.5) that it reaches after about 0.07 s
+//             wall at x max (mu = 0.5) that it reaches after about 0.05 s and rebounds from
 #pragma once
 
 #include "../../benchmarks/p1_scene.h"

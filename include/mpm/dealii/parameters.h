@@ -27,9 +27,11 @@ namespace mpm
 
   struct BodyParameters
   {
-    std::string                        shape; // box | polygon
+    std::string                        shape; // box | polygon | cylinder
     std::vector<double>                lower, upper;
     std::vector<std::array<double, 2>> polygon; // (horizontal, vertical) pairs
+    std::array<double, 2>              axis{};  // cylinder: (x, y) of its vertical axis
+    double                             radius = 0;
     unsigned int                       points_per_direction;
     double                             density;
     std::vector<double>                velocity;
