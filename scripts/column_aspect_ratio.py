@@ -3,6 +3,7 @@
 
 Usage: column_aspect_ratio.py --lambda L [--cells-per-radius N] [--base friction|no-slip]
                               [--friction-coefficient MU] [--damping D] [--backend cpu|cuda]
+                              [--shape-function GIMP|linear] [--flip-fraction ALPHA]
                               [--end-time T] [--output DIR] [--table-only] [--template PRM] > scene.prm
 
 lambda0 = h0 / r0 is the one parameter of the scene: it sets the column height, the grid that
@@ -67,6 +68,8 @@ def main():
     parser.add_argument("--friction-coefficient", type=float, default=math.tan(math.radians(37.55)))
     parser.add_argument("--damping", type=float, default=0.0)
     parser.add_argument("--backend", choices=["cpu", "cuda"], default="cpu")
+    parser.add_argument("--shape-function", choices=["GIMP", "linear"], default="GIMP")
+    parser.add_argument("--flip-fraction", type=float, default=0.99)
     parser.add_argument("--end-time", type=float, default=None, help="default: 5 sqrt(h0 / g) + 0.5 s")
     parser.add_argument("--output", default=None, help="the run's output directory")
     parser.add_argument("--table-only", action="store_true",
@@ -90,6 +93,9 @@ def main():
         (("Boundary conditions",), "Friction coefficient"): number(args.friction_coefficient),
         (("Solver",), "End time"): number(end_time),
         (("Solver",), "Local damping"): number(args.damping),
+        (("Solver",), "Shape function"): args.shape_function,
+        (("Solver",), "GIMP domain update"): "det F" if args.shape_function == "GIMP" else "none",
+        (("Solver",), "FLIP fraction"): number(args.flip_fraction),
         (("Material points", "Body 1"), "Upper corner"): f"{number(R0)}, {number(R0)}, {number(height)}",
     }
     if args.table_only:
@@ -101,7 +107,7 @@ def main():
         lines = set_entries(f.readlines(), changes)
     sys.stdout.write(f"# Written by scripts/column_aspect_ratio.py: lambda0 = {number(args.aspect_ratio)}, "
                      f"{args.cells_per_radius} cells per r0, base {args.base}, D = {number(args.damping)}, "
-                     f"backend {args.backend}\n")
+                     f"{args.shape_function}, FLIP {number(args.flip_fraction)}, backend {args.backend}\n")
     sys.stdout.writelines(lines)
     if args.backend == "cuda":
         sys.stdout.write("\nsubsection Backend\n  set Backend = cuda\nend\n")
