@@ -16,6 +16,12 @@ namespace mpm
     {
       return std::find(boundary.begin(), boundary.end(), BoundaryType::friction) != boundary.end();
     }
+
+    // mu of boundary id `id` (0 unless the face is friction).
+    double face_friction_coefficient(const Parameters &parameters, const unsigned int id)
+    {
+      return parameters.boundary[id] == BoundaryType::friction ? parameters.friction_coefficient : 0.0;
+    }
   } // namespace
 
   template <int dim>
@@ -45,8 +51,7 @@ namespace mpm
       {
         grid.friction_faces.assign(n_nodes, 0);
         for (unsigned int id = 0; id < 2 * dim; ++id)
-          grid.friction_coefficient[id] =
-            parameters.boundary[id] == BoundaryType::friction ? parameters.friction_coefficient : 0.0;
+          grid.friction_coefficient[id] = face_friction_coefficient(parameters, id);
       }
     for (long l = 0; l < n_nodes; ++l)
       {
@@ -85,9 +90,8 @@ namespace mpm
     , dof_handler(triangulation)
     , boundary(parameters.boundary)
   {
-    if (has_friction_face(parameters.boundary))
-      for (unsigned int id = 0; id < 2 * dim; ++id)
-        friction_coefficient[id] = boundary[id] == BoundaryType::friction ? parameters.friction_coefficient : 0.0;
+    for (unsigned int id = 0; id < 2 * dim; ++id)
+      friction_coefficient[id] = face_friction_coefficient(parameters, id);
     const HostGrid<dim, double> lattice = lattice_geometry<dim>(parameters);
     h = lattice.h;
     std::vector<unsigned int> repetitions(dim);

@@ -97,13 +97,14 @@ namespace mpm
                           std::string("Condition on the grid face ") + axis_names[d] + " = " + side +
                             " (boundary id " + std::to_string(2 * d + (side == std::string("max"))) +
                             "): free, no-slip (all velocity components zero), free-slip (roller: normal "
-                            "component zero) or friction (normal component zero, Coulomb friction with "
-                            "the Friction coefficient on the tangential velocity).");
+                            "component zero) or friction (a rigid wall with Coulomb friction, coefficient "
+                            "Friction coefficient: where material presses on it, normal component zero and "
+                            "the tangential one braked; where material moves away, nothing).");
     prm.declare_entry("Friction coefficient", "0", Patterns::Double(0),
                       "Coulomb friction coefficient mu of every face set to friction: where material presses "
                       "on the wall, the tangential velocity of a wall node is reduced by mu times its normal "
                       "velocity into the wall, to rest at most. Must be > 0 where a face is friction "
-                      "(mu = 0 is free-slip).");
+                      "(for a wall without friction use free-slip).");
     prm.leave_subsection();
 
     prm.enter_subsection("Solver");

@@ -1,11 +1,14 @@
 // Small scenes shared by the core tests and benchmarks.
 #pragma once
 
+#include <mpm/core/backend/cpu_backend.h>
 #include <mpm/core/host_storage.h>
 #include <mpm/core/material/material.h>
 #include <mpm/core/step.h>
 
+#include <algorithm>
 #include <random>
+#include <vector>
 
 namespace mpm_test
 {
@@ -59,5 +62,41 @@ namespace mpm_test
         p.plastic_strain[i]               = 0;
         p.material[i]                     = 0;
       }
+  }
+  // What a block that slides along x did: its centre of mass moved by `distance`, and it ends
+  // with the mean velocity `speed` (momentum over mass along x).
+  struct Slide
+  {
+    double distance;
+    double speed;
+  };
+
+  // Runs the points on the CPU with GIMP to t_end at CFL 0.5 (c: the elastic wave speed) and
+  // reports their slide along x.
+  template <int dim>
+  Slide slide_along_x(mpm::HostGrid<dim, double> &grid, mpm::HostPoints<dim, double> &p,
+                      const std::vector<mpm::MaterialParameters<double>> &materials,
+                      const mpm::StepSettings<dim, double> &s, const double c, const double t_end)
+  {
+    mpm::CpuBackend backend;
+    auto            centre = [&]() {
+      double mx = 0, m = 0;
+      for (int i = 0; i < p.size(); ++i)
+        mx += p.mass[i] * p.position[0][i], m += p.mass[i];
+      return mx / m;
+    };
+    const double x0 = centre();
+    double       t = 0, max_speed = 0;
+    while (t < t_end)
+      {
+        const double dt = std::min(0.5 * grid.h / (c + max_speed), t_end - t);
+        max_speed = mpm::explicit_step<dim, mpm::GimpShape>(backend, grid.view(), p.view(), materials.data(), s, dt)
+                      .max_speed;
+        t += dt;
+      }
+    double momentum = 0, mass = 0;
+    for (int i = 0; i < p.size(); ++i)
+      momentum += p.mass[i] * p.velocity[0][i], mass += p.mass[i];
+    return {centre() - x0, momentum / mass};
   }
 } // namespace mpm_test

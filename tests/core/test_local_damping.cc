@@ -34,6 +34,7 @@
 using namespace mpm;
 using mpm_test::check;
 using mpm_test::check_below;
+using mpm_test::Slide;
 
 namespace
 {
@@ -88,12 +89,6 @@ namespace
     check_below(worst, 1e-15, "damping never adds power");
   }
 
-  struct Slide
-  {
-    double distance; // of the centre of mass along x
-    double speed;    // mean horizontal speed at the end
-  };
-
   Slide slide(const LocalDampingForm form, const double t_end)
   {
     const double h = 0.125, rho = 1000, E = 1e8, g = 10, v0 = 1, D = 0.05, height = 1, length = 2;
@@ -120,27 +115,8 @@ namespace
     s.damping_form   = form;
     s.domain_update  = DomainUpdate::none;
     s.mass_tolerance = 1e-12 * p.mass[0];
-    std::vector<MaterialParameters<double>> materials = {mpm_test::elastic(E, 0)};
-    CpuBackend                              backend;
-    const double                            c = std::sqrt(E / rho);
-    double                                  t = 0, max_speed = 0;
-    auto                                    centre = [&]() {
-      double mx = 0, m = 0;
-      for (int i = 0; i < p.size(); ++i)
-        mx += p.mass[i] * p.position[0][i], m += p.mass[i];
-      return mx / m;
-    };
-    const double x0 = centre();
-    while (t < t_end)
-      {
-        const double dt = std::min(0.5 * h / (c + max_speed), t_end - t);
-        max_speed = explicit_step<2, GimpShape>(backend, grid.view(), p.view(), materials.data(), s, dt).max_speed;
-        t += dt;
-      }
-    double momentum = 0, mass = 0;
-    for (int i = 0; i < p.size(); ++i)
-      momentum += p.mass[i] * p.velocity[0][i], mass += p.mass[i];
-    return {centre() - x0, momentum / mass};
+    const std::vector<MaterialParameters<double>> materials = {mpm_test::elastic(E, 0)};
+    return mpm_test::slide_along_x(grid, p, materials, s, std::sqrt(E / rho), t_end);
   }
 
   void test_sliding_block()

@@ -46,6 +46,7 @@
 using namespace mpm;
 using mpm_test::check;
 using mpm_test::check_below;
+using mpm_test::Slide;
 
 namespace
 {
@@ -97,12 +98,6 @@ namespace
     check_below(worst, 0.0, "friction never adds kinetic energy");
   }
 
-  struct Slide
-  {
-    double distance; // of the centre of mass along the base
-    double speed;    // mean speed along the base at the end
-  };
-
   struct Method
   {
     UpdateScheme scheme;
@@ -146,27 +141,8 @@ namespace
     s.domain_update  = DomainUpdate::none;
     s.mass_tolerance = 1e-12 * p.mass[0];
     s.flip_fraction  = method.flip_fraction;
-    std::vector<MaterialParameters<double>> materials = {mpm_test::elastic(E, 0)};
-    CpuBackend                              backend;
-    const double                            c = std::sqrt(E / rho);
-    double                                  t = 0, max_speed = 0;
-    auto                                    centre = [&]() {
-      double mx = 0, m = 0;
-      for (int i = 0; i < p.size(); ++i)
-        mx += p.mass[i] * p.position[0][i], m += p.mass[i];
-      return mx / m;
-    };
-    const double x0 = centre();
-    while (t < t_end)
-      {
-        const double dt = std::min(0.5 * h / (c + max_speed), t_end - t);
-        max_speed = explicit_step<2, GimpShape>(backend, grid.view(), p.view(), materials.data(), s, dt).max_speed;
-        t += dt;
-      }
-    double momentum = 0, mass = 0;
-    for (int i = 0; i < p.size(); ++i)
-      momentum += p.mass[i] * p.velocity[0][i], mass += p.mass[i];
-    return {centre() - x0, momentum / mass};
+    const std::vector<MaterialParameters<double>> materials = {mpm_test::elastic(E, 0)};
+    return mpm_test::slide_along_x(grid, p, materials, s, std::sqrt(E / rho), t_end);
   }
 
   void test_stopping_distance(const Method &method)

@@ -1,8 +1,8 @@
 // On one rank the engine starts before deal.II's grid and ParticleHandler exist
 // (simulator.cc): its nodes come from lattice_grid() and its points from
 // points_of_bodies(). Both must be what the grid and the handler would have given:
-//  - lattice_grid's boundary masks equal BackgroundGrid's (set from the faces' boundary
-//    ids) at every node, for boundaries of every type on different faces;
+//  - lattice_grid's boundary and friction masks equal BackgroundGrid's (set from the faces'
+//    boundary ids) at every node, for boundaries of every type on different faces;
 //  - points_of_bodies gives every array of every point and its labels exactly as
 //    MaterialPoints::insert + copy_to do (matched by particle id), ordered cell by cell;
 //  - an engine on its own lattice nodes steps exactly as one on the grid's vectors: the
@@ -31,11 +31,15 @@ namespace
   {
     Parameters p = mpm_test::box_domain<dim>(0.08, 0.01);
     p.upper[0]   = 0.12;
-    // Every type, on faces of every direction: x min no-slip, x max free-slip, y min free, ...
-    p.boundary = {{BoundaryType::no_slip, BoundaryType::free_slip, BoundaryType::free,
+    // Every type, on faces of every direction: x min no-slip, x max free-slip, y min friction, ...
+    p.boundary = {{BoundaryType::no_slip, BoundaryType::free_slip, BoundaryType::friction,
                    BoundaryType::free_slip, BoundaryType::no_slip, BoundaryType::free}};
     if (dim == 2)
-      p.boundary[2] = BoundaryType::no_slip; // the floor
+      {
+        p.boundary[2] = BoundaryType::no_slip; // the floor
+        p.boundary[3] = BoundaryType::friction;
+      }
+    p.friction_coefficient = 0.5;
     p.gravity[dim - 1] = -9.81;
     BodyParameters body  = mpm_test::box_body<dim>(0.0, 0.04, 2, 2000);
     body.initial_stress  = "geostatic";
@@ -88,6 +92,19 @@ namespace
       }
     mpm_test::check(n == g.n_nodes, "lattice_grid has every node of the grid", n, g.n_nodes);
     mpm_test::check(differ == 0, "lattice_grid's boundary masks equal BackgroundGrid's", differ, 0);
+    // Friction masks and coefficients alike; some nodes lie on the frictional face.
+    long differ_friction = 0, on_friction_face = 0;
+    const bool both = !lattice.friction_faces.empty() && g.friction_faces != nullptr;
+    for (long l = 0; both && l < n; ++l)
+      {
+        const std::uint8_t expected = g.friction_faces[g.lattice_to_node[l]];
+        differ_friction += lattice.friction_faces[l] != expected;
+        on_friction_face += expected != 0;
+      }
+    for (int f = 0; f < 2 * dim; ++f)
+      differ_friction += lattice.friction_coefficient[f] != g.friction_coefficient[f];
+    mpm_test::check(both && differ_friction == 0 && on_friction_face > 0,
+                    "lattice_grid's friction masks and coefficients equal BackgroundGrid's", differ_friction, 0);
     // The comparison means something only where the masks are not all alike.
     long kinds = 0;
     for (const long c : count_of_mask)

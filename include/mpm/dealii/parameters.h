@@ -22,7 +22,7 @@ namespace mpm
     free,      // no constraint
     no_slip,   // every velocity component zero
     free_slip, // normal velocity component zero (roller)
-    friction   // normal velocity component zero, Coulomb friction on the tangential (wall_friction.h)
+    friction   // rigid wall with Coulomb friction, unilateral contact (wall_friction.h)
   };
 
   struct BodyParameters
