@@ -265,7 +265,11 @@ namespace mpm
       for (int d = 0; d < dim; ++d)
         g += parameters.gravity[d] * parameters.gravity[d];
       g = std::sqrt(g);
-      double lowest = 1e300, highest = -1e300;
+      double lowest = 1e300, highest = -1e300, smallest_domain = h;
+      for (int i = 0; i < p0.size(); ++i)
+        if (p0.material[i] >= 0)
+          for (int d = 0; d < dim; ++d)
+            smallest_domain = std::min(smallest_domain, p0.domain_half_length[d][i]);
       for (int i = 0; i < p0.size(); ++i)
         if (p0.material[i] >= 0 && g > 0)
           {
@@ -286,6 +290,18 @@ namespace mpm
       // the points held in place: the equilibrium of the geometry given, not of one the points
       // creep into (at a free surface a point whose domain just reaches a node's support feels
       // that light node's large acceleration, and drifts).
+      //
+      // With GIMP the grid keeps its velocities between the steps (a dynamic relaxation on
+      // the grid); rebuilt from the points, the light nodes at a free surface relax over
+      // thousands of steps and leave forces that FLIP then turns into creeping point
+      // velocities (doc/log.md). A light node whose points reach it with the tail of a
+      // domain of half-length l has a stiffness over mass of up to c^2 sum_d 1/(l_d h),
+      // so the step is cut to a Courant number of sqrt(l_min / (dim h)) (at most the
+      // run's): omega dt <= 1 for the stiffest such node. Linear shape functions give no
+      // such bound (a point close to a node line makes the node's ratio unbounded): there
+      // the velocities are rebuilt from the points, which is stable, and slower.
+      const bool   on_grid = parameters.shape_function == ShapeFunction::gimp;
+      const double courant = on_grid ? std::sqrt(global_min(smallest_domain) / (dim * h)) : 1e300;
       const double damping = settings.damping, flip_fraction = settings.flip_fraction;
       settings.damping       = parameters.equilibration_damping;
       settings.flip_fraction = 0;
@@ -303,8 +319,10 @@ namespace mpm
                         dealii::Utilities::to_string(parameters.equilibration_tolerance) +
                         "). Either the state is not stable under these materials (it fails under its own "
                         "weight), or it needs more steps: raise the maximum or the tolerance."));
-          const double dt = parameters.adaptive_time_step ? parameters.cfl * h / (c_el + max_speed) :
-                                                            parameters.fixed_time_step;
+          const double dt = parameters.adaptive_time_step ?
+                              std::min(parameters.cfl, courant) * h / (c_el + max_speed) :
+                              std::min(parameters.fixed_time_step, courant * h / c_el);
+          settings.hold_from_point_momentum = !on_grid || equilibration.steps == 0;
           engine_step(dt);
           ++equilibration.steps;
           calm = max_speed < parameters.equilibration_tolerance * equilibration.reference_speed ? calm + dt : 0;

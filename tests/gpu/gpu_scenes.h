@@ -5,7 +5,8 @@
 //             elastic or Drucker-Prager, gravity ramp, local damping 0.1 (either form), free-slip walls
 //             and base
 //   collapse: V3 geometry (2D, 0.2 m x 0.1 m column against a wall), h = 5 mm, 2x2 ppc,
-//             elastic or Drucker-Prager; no-slip base, rollers on walls, gravity applied at once
+//             elastic or Drucker-Prager; no-slip base, rollers on walls, gravity applied at once;
+//             or held, the equilibration's damped steps on the grid
 //   slide   : 3D elastic block (0.4 x 0.3 x 0.2 m, h = 5 cm, 1,536 points, geostatic stress)
 //             thrown at (2, 1, 0) m/s over a frictional base (mu = 0.3) against a frictional
 //             wall at x max (mu = 0.5) that it reaches after about 0.05 s and rebounds from
@@ -67,12 +68,17 @@ namespace mpm_test
 
   // V3 geometry (2D), gravity at once; elastic, or V3's Drucker-Prager (c = 0,
   // phi = 19.8 deg, psi = 0: the column starts to fail within the first steps).
+  // held: the equilibration's steps instead (StepSettings::hold_points, the grid keeping its
+  // velocities from the second step on, damping 0.8, PIC, the Courant number bounded by the
+  // points' domains as in the equilibration).
   template <template <int, typename> class Target>
   SceneResult collapse(mpm::HostPoints<2, double> &points, const long n_steps,
-                       const mpm::HostPoints<2, double> *initial = nullptr, const bool drucker_prager = false)
+                       const mpm::HostPoints<2, double> *initial = nullptr, const bool drucker_prager = false,
+                       const bool held = false)
   {
     using namespace mpm;
-    const double h = 0.005, rho = 2650, E = 0.84e6, nu = 0.3, g = 9.81, cfl = 0.5;
+    const double h = 0.005, rho = 2650, E = 0.84e6, nu = 0.3, g = 9.81;
+    const double cfl = held ? std::sqrt(0.25 / 2) : 0.5; // sqrt(l / (dim h)), l = h / 4
     const double length = 0.5, height = 0.15;
     HostGrid<2, double> grid;
     const double        lower[2] = {-2 * h, -2 * h};
@@ -115,13 +121,20 @@ namespace mpm_test
     s.flip_fraction  = 1.0;
     s.domain_update  = DomainUpdate::det_F;
     s.mass_tolerance = 1e-12 * points.mass[0];
+    if (held)
+      {
+        s.hold_points   = true;
+        s.damping       = 0.8;
+        s.flip_fraction = 0;
+      }
     Target<2, double> target(grid, points, {m});
     auto              gv = target.grid();
     SceneResult       r;
     double            max_speed = 0;
     for (; r.n_steps < n_steps; ++r.n_steps)
       {
-        const double dt = cfl * h / (c + max_speed);
+        const double dt            = cfl * h / (c + max_speed);
+        s.hold_from_point_momentum = r.n_steps == 0;
         const auto pv = target.template points_at_step<GimpShape>(r.n_steps);
         max_speed = explicit_step<2, GimpShape>(target.backend, gv, pv, target.material_table(), s, dt).max_speed;
         r.time += dt;

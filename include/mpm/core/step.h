@@ -57,6 +57,14 @@ namespace mpm
     // stresses follow the grid's velocities. The equilibration of an initial state uses it,
     // so that the MPM's equilibrium is found in the geometry handed over.
     bool hold_points = false;
+    // With hold_points the grid keeps its velocities from step to step, as a dynamic
+    // relaxation on the grid (FLAC's): a node's velocity before the update is the last held
+    // step's, not one rebuilt from the points' momentum. Rebuilt, a light node at a free
+    // surface (its mass from the tails of a few GIMP domains) sees almost none of its own
+    // velocity come back through the points, so it never gathers speed: its stiff-less
+    // modes relax over thousands of steps (doc/log.md). The first held step, with this
+    // set, starts from the points' momentum.
+    bool hold_from_point_momentum = false;
   };
 
   // Per-step reductions over the points: the next time step needs the largest speed,
@@ -337,10 +345,16 @@ namespace mpm
         // A node on a frictional wall keeps its velocity before the update, from which the
         // wall's correction of the new velocity gives the acceleration FLIP needs.
         const std::uint8_t faces = g.friction_faces != nullptr && m > s.mass_tolerance ? g.friction_faces[n] : 0;
-        Real               v_old[dim];
+        // The node's velocity before the update: from the points' momentum, or with the
+        // points held the grid's own of the last held step.
+        const bool grid_velocity = s.hold_points && !s.hold_from_point_momentum;
+        const auto velocity_before = [&](const int d) {
+          return grid_velocity ? g.velocity[d][n] : g.momentum[d][n] / m;
+        };
+        Real v_old[dim];
         if (faces != 0)
           for (int d = 0; d < dim; ++d)
-            v_old[d] = (g.fixed_components[n] >> d) & 1u ? Real(0) : g.momentum[d][n] / m;
+            v_old[d] = (g.fixed_components[n] >> d) & 1u ? Real(0) : velocity_before(d);
         for (int d = 0; d < dim; ++d)
           {
             const bool fixed = (g.fixed_components[n] >> d) & 1u;
@@ -349,11 +363,12 @@ namespace mpm
                 g.momentum[d][n] = g.force[d][n] = g.velocity[d][n] = Real(0);
                 continue;
               }
-            const Real v     = g.momentum[d][n] / m;
+            const Real v     = velocity_before(d);
             const Real f     = damped_force_component(g.force[d][n], v, norm, s.damping, s.damping_form,
                                                       s.damping_threshold);
-            const Real p_new = g.momentum[d][n] + dt * f;
-            const Real v_new = p_new / m;
+            // (Two forms, so that the points' path keeps its rounding.)
+            const Real p_new = grid_velocity ? m * (v + dt * (f / m)) : g.momentum[d][n] + dt * f;
+            const Real v_new = grid_velocity ? v + dt * (f / m) : p_new / m;
             g.momentum[d][n] = zero_momentum ? Real(0) : p_new;
             g.velocity[d][n] = v_new;
             g.force[d][n]    = s.flip_fraction * (dt * (f / m)) + (Real(1) - s.flip_fraction) * v_new;
@@ -820,7 +835,8 @@ namespace mpm
             update_grid(backend, g, s, dt, true, apply_pending);
             grid_to_particle_velocity_and_remap<dim, Shape>(backend, g, p, s, stencils);
             exchange.sum_nodal(momentum, dim);
-            velocity_from_momentum(backend, g, s.mass_tolerance);
+            if (!s.hold_points || s.hold_from_point_momentum) // held, the grid keeps its updated ones
+              velocity_from_momentum(backend, g, s.mass_tolerance);
             grid_to_particle_kinematics<dim, Shape>(backend, g, p, materials, s, dt, true, true, stencils,
                                                     scatter_in_kinematics);
           }
@@ -843,7 +859,8 @@ namespace mpm
           reset_grid(backend, g, true);
           particles_to_grid<dim, Shape>(backend, g, p, s, true, false);
           exchange.sum_nodal(mass_and_momentum, dim + 1);
-          velocity_from_momentum(backend, g, s.mass_tolerance);
+          if (!s.hold_points || s.hold_from_point_momentum) // held, the last step's grid velocities
+            velocity_from_momentum(backend, g, s.mass_tolerance);
           grid_to_particle_kinematics<dim, Shape>(backend, g, p, materials, s, dt, false, true);
           if (s.pressure_averaging)
             average_cell_pressure(backend, g, p, exchange);
