@@ -123,18 +123,30 @@ int main()
         report<2>("V1 column, GPU sorted every 7", compare_points(cpu, gpu, 10.0 / 32), spread, n, true);
       }
       {
-        // V3 geometry, elastic, 600 steps of the equilibration (points held, the grid keeping
-        // its velocities, damped): only the stresses change
-        const long            n = 600;
+        // V3 geometry, elastic, the equilibration's steps (points held, the grid keeping its
+        // velocities, damping 0.8) from zero stress. The damped path follows round-off (the
+        // damping's sign of a nodal velocity near zero: after 600 steps the CPU with its points
+        // reordered differs by 3e-3 of the largest stress, the GPU alike, measured on the H100),
+        // but where it ends does not: after 6000 steps the column is near its equilibrium and the
+        // GPU's stresses are the CPU's to 2e-6 (H100; CPU reordered 2e-6). Asked: 1e-5, the points
+        // not moved.
+        const long            n = 6000;
         HostPoints<2, double> cpu, gpu, initial;
         collapse<CpuTarget>(initial, 0);
         collapse<CpuTarget>(cpu, n, &initial, false, true);
-        const Difference spread = cpu_reordering_spread(
-          initial, cpu, 0.005, [&](auto &out, const auto *start) { collapse<CpuTarget>(out, n, start, false, true); });
-        collapse<CudaTarget>(gpu, n, &initial, false, true);
-        report<2>("V3 column held, equilibration steps", compare_points(cpu, gpu, 0.005), spread, n, true);
-        collapse<CudaSortedTarget>(gpu, n, &initial, false, true);
-        report<2>("V3 column held, GPU sorted every 7", compare_points(cpu, gpu, 0.005), spread, n, true);
+        for (const bool sorted : {false, true})
+          {
+            if (sorted)
+              collapse<CudaSortedTarget>(gpu, n, &initial, false, true);
+            else
+              collapse<CudaTarget>(gpu, n, &initial, false, true);
+            const Difference d = compare_points(cpu, gpu, 0.005);
+            std::printf("%-34s %6ld steps | GPU-CPU: x/h %.1e sigma %.1e\n",
+                        sorted ? "V3 column held, GPU sorted every 7" : "V3 column held, equilibration steps", n,
+                        d.position, d.stress);
+            check(d.position == 0, "held steps: the points have not moved, on CPU and GPU");
+            check_below(d.stress, 1e-5, "held steps: GPU and CPU reach the same equilibrium (stress within 1e-5)");
+          }
       }
       {
         // V3 geometry, elastic, 600 steps of gravity applied at once
