@@ -433,6 +433,30 @@ namespace mpm
   }
 
   template <int dim>
+  void MaterialPoints<dim>::replace(const PointSnapshot<dim> &all)
+  {
+    handler.clear_particles();
+    std::vector<double> properties(PropertyLayout<dim>::n_properties);
+    for (int i = 0; i < all.points.size(); ++i)
+      {
+        if (all.points.material[i] < 0)
+          continue;
+        double             x[dim];
+        dealii::Point<dim> location;
+        for (int d = 0; d < dim; ++d)
+          location[d] = x[d] = all.points.position[d][i];
+        const auto cell = grid.owned_cell(grid.lattice_cell_of(x));
+        if (cell == grid.triangulation.end())
+          continue; // another rank owns this point's cell
+        all.properties(i, properties.data());
+        handler.insert_particle(location, grid.mapping.transform_real_to_unit_cell(cell, location),
+                                all.labels->id[i], cell,
+                                dealii::ArrayView<const double>(properties.data(), properties.size()));
+      }
+    handler.update_cached_numbers();
+  }
+
+  template <int dim>
   unsigned int MaterialPoints<dim>::copy_from(const HostPoints<dim, double> &p)
   {
     using Layout = PropertyLayout<dim>;

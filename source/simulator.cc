@@ -875,14 +875,74 @@ namespace mpm
   {
     State &s = *state;
     AssertThrow(s.set_up, dealii::ExcMessage("Simulator::set_points() needs setup() first."));
-    AssertThrow(!s.parallel, dealii::ExcMessage("Simulator::set_points() runs on one MPI rank for now."));
     PointSnapshot<dim> snapshot;
     s.engine->snapshot(snapshot);
-    AssertThrow(new_points.size() == snapshot.points.size(),
-                dealii::ExcMessage("Simulator::set_points(): " + std::to_string(new_points.size()) +
-                                   " points given, the run holds " + std::to_string(snapshot.points.size()) +
-                                   "; give the same points, in the order points() returned them."));
-    s.engine->load(new_points, snapshot.labels);
+    // What is wrong with this rank's points, if anything; every rank stops when one does
+    // (the migration below is collective).
+    std::string       wrong;
+    const Parameters &p = s.parameters;
+    if (new_points.size() != snapshot.points.size())
+      wrong = std::to_string(new_points.size()) + " points given, the run holds " +
+              std::to_string(snapshot.points.size()) +
+              (s.parallel ? " on MPI rank " + std::to_string(dealii::Utilities::MPI::this_mpi_process(s.communicator)) :
+                            std::string()) +
+              "; give the same points, in the order points() returned them.";
+    // A point placed outside the grid would be lost without a word (the handler drops it).
+    for (int i = 0; i < new_points.size() && wrong.empty(); ++i)
+      for (int d = 0; d < dim && wrong.empty(); ++d)
+        if (new_points.material[i] >= 0 &&
+            !(new_points.position[d][i] >= p.lower[d] && new_points.position[d][i] <= p.upper[d]))
+          wrong = "point " + std::to_string(i) + " at " + std::string("xyz").substr(d, 1) + " = " +
+                  dealii::Utilities::to_string(new_points.position[d][i]) +
+                  " lies outside the grid (Grid/Lower corner and Upper corner: [" +
+                  dealii::Utilities::to_string(p.lower[d]) + ", " + dealii::Utilities::to_string(p.upper[d]) + "]).";
+    const bool refused_anywhere = s.global_max(wrong.empty() ? 0 : 1) > 0;
+    AssertThrow(wrong.empty(), dealii::ExcMessage("Simulator::set_points(): " + wrong));
+    AssertThrow(!refused_anywhere, dealii::ExcMessage("Simulator::set_points(): another MPI rank's points were "
+                                                      "refused (its message says why)."));
+    if (!s.parallel)
+      return s.engine->load(new_points, snapshot.labels);
+    // Points may have been moved any distance: every rank gets all of them (as setup()
+    // gets handed-over points) and keeps those in its cells, ids and labels kept.
+    dealii::TimerOutput::Scope scope(s.timer, "migrate points");
+    std::vector<double>        packed{double(new_points.size())};
+    for_each_point_array<dim>(new_points, new_points, [&](const auto &array, const auto &) {
+      packed.insert(packed.end(), array.begin(), array.end());
+    });
+    packed.insert(packed.end(), snapshot.labels->id.begin(), snapshot.labels->id.end());
+    for (int d = 0; d < dim; ++d)
+      packed.insert(packed.end(), snapshot.labels->initial_position[d].begin(),
+                    snapshot.labels->initial_position[d].end());
+    const std::vector<std::vector<double>> ranks = dealii::Utilities::MPI::all_gather(s.communicator, packed);
+    int                                    total = 0;
+    for (const std::vector<double> &from_rank : ranks)
+      total += static_cast<int>(from_rank[0]);
+    PointSnapshot<dim> all;
+    auto               labels = std::make_shared<PointLabels<dim>>();
+    all.points.resize(total);
+    int offset = 0;
+    for (const std::vector<double> &from_rank : ranks)
+      {
+        const int   n  = static_cast<int>(from_rank[0]);
+        std::size_t at = 1;
+        for_each_point_array<dim>(all.points, all.points, [&](auto &array, auto &) {
+          using T = typename std::decay_t<decltype(array)>::value_type;
+          for (int k = 0; k < n; ++k)
+            array[offset + k] = static_cast<T>(from_rank[at++]);
+        });
+        for (int k = 0; k < n; ++k)
+          labels->id.push_back(static_cast<dealii::types::particle_index>(from_rank[at++]));
+        for (int d = 0; d < dim; ++d)
+          for (int k = 0; k < n; ++k)
+            labels->initial_position[d].push_back(from_rank[at++]);
+        offset += n;
+      }
+    all.labels = labels;
+    s.points->replace(all);
+    s.engine->load(*s.points);
+    ++s.n_resorts;
+    if (s.balance())
+      s.engine->load(*s.points);
   }
 
   namespace

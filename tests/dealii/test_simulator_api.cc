@@ -5,8 +5,8 @@
 //  - points() then set_points() of the same values changes nothing; a changed field reaches the
 //    step (a velocity given to every point moves the body's centre of mass by v dt in the next
 //    step, up to the step's own motion);
-//  - misuse stops with a message: set_points with another number of points, advance() before
-//    setup(), setup() twice.
+//  - misuse stops with a message: set_points with another number of points or a point outside
+//    the grid, advance() before setup(), setup() twice.
 #include "../core/check.h"
 
 #include <mpm/dealii/parameters.h>
@@ -104,6 +104,10 @@ int main(int argc, char **argv)
       fewer.resize(fewer.size() - 1);
       check(throws_naming([&]() { moved.set_points(fewer); }, "3199 points given, the run holds 3200"),
             "set_points with another number of points is refused, naming both counts");
+      HostPoints<2, double> outside = moved.points();
+      outside.position[1][7] = 0.13; // the grid ends at y = 0.12
+      check(throws_naming([&]() { moved.set_points(outside); }, "point 7 at y = 0.13 lies outside the grid"),
+            "set_points with a point outside the grid is refused, naming the point and the grid");
       Simulator<2> fresh(scene("output-api-fresh"), MPI_COMM_WORLD);
       check(throws_naming([&]() { fresh.advance(); }, "needs setup() first"), "advance() before setup()");
       fresh.setup();

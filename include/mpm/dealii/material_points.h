@@ -108,6 +108,12 @@ namespace mpm
     void copy_to(HostPoints<dim, double> &points, std::vector<long> *home_cells = nullptr,
                  PointLabels<dim> *labels = nullptr) const;
 
+    // Every rank's points at once (each rank gives the same `all`): the handler's points
+    // are replaced by those of `all` that lie in this rank's cells, with their ids and
+    // initial positions from all.labels; points with material < 0 are left out. Unlike
+    // copy_from it moves points any distance (copy_from reaches only the ghost cells).
+    void replace(const PointSnapshot<dim> &all);
+
     // Core arrays -> handler: positions and properties; points the core marked as
     // having left the grid are removed. Then the handler re-sorts points into cells
     // and ranks (points now in another rank's cell migrate there with all their

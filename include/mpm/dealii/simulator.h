@@ -80,7 +80,9 @@ namespace mpm
     // arrays (HostPoints): position, velocity, mass, volume, stress, strain, F, ...
     HostPoints<dim, double> points() const;
     // Replaces the points' values: the same points in the same order (as points() gave
-    // them), any field changed. One MPI rank for now.
+    // them), any field changed. On several MPI ranks, collective: each rank gives its own
+    // points; those moved into another rank's cells migrate there (points() then returns
+    // the new partition's). A point outside the grid is refused.
     void set_points(const HostPoints<dim, double> &points);
 
   private:
