@@ -30,6 +30,28 @@ namespace mpm_test
     double error   = 0; // column: the V1 error norm (full runs only)
   };
 
+  // n_steps of a scene at the adaptive time step cfl h / (c + largest speed); held scenes
+  // (s.hold_points) take their first step from the points' momentum, as the equilibration does.
+  template <int dim, typename SceneTarget>
+  SceneResult step_scene(SceneTarget &target, mpm::StepSettings<dim, double> &s, const double cfl, const double h,
+                         const double c, const long n_steps)
+  {
+    auto        gv = target.grid();
+    SceneResult r;
+    double      max_speed = 0;
+    for (; r.n_steps < n_steps; ++r.n_steps)
+      {
+        const double dt            = cfl * h / (c + max_speed);
+        s.hold_from_point_momentum = s.hold_points && r.n_steps == 0;
+        const auto pv              = target.template points_at_step<mpm::GimpShape>(r.n_steps);
+        max_speed =
+          mpm::explicit_step<dim, mpm::GimpShape>(target.backend, gv, pv, target.material_table(), s, dt).max_speed;
+        r.time += dt;
+      }
+    target.finish();
+    return r;
+  }
+
   // P1 slump geometry, n_cells_y cells across, elastic phase, fixed number of steps.
   template <template <int, typename> class Target, typename Real = double>
   SceneResult slump(const int n_cells_y, mpm::HostPoints<3, Real> &points, const long n_steps,
@@ -128,19 +150,7 @@ namespace mpm_test
         s.flip_fraction = 0;
       }
     Target<2, double> target(grid, points, {m});
-    auto              gv = target.grid();
-    SceneResult       r;
-    double            max_speed = 0;
-    for (; r.n_steps < n_steps; ++r.n_steps)
-      {
-        const double dt            = cfl * h / (c + max_speed);
-        s.hold_from_point_momentum = r.n_steps == 0;
-        const auto pv = target.template points_at_step<GimpShape>(r.n_steps);
-        max_speed = explicit_step<2, GimpShape>(target.backend, gv, pv, target.material_table(), s, dt).max_speed;
-        r.time += dt;
-      }
-    target.finish();
-    return r;
+    return step_scene<2>(target, s, cfl, h, c, n_steps);
   }
 
   // The slide: frictional walls (wall_friction.h) on the base and on the wall it runs into.
@@ -191,17 +201,6 @@ namespace mpm_test
     s.domain_update  = DomainUpdate::det_F;
     s.mass_tolerance = 1e-12 * points.mass[0];
     Target<3, double> target(grid, points, {m});
-    auto              gv = target.grid();
-    SceneResult       r;
-    double            max_speed = 0;
-    for (; r.n_steps < n_steps; ++r.n_steps)
-      {
-        const double dt = cfl * h / (c + max_speed);
-        const auto   pv = target.template points_at_step<GimpShape>(r.n_steps);
-        max_speed = explicit_step<3, GimpShape>(target.backend, gv, pv, target.material_table(), s, dt).max_speed;
-        r.time += dt;
-      }
-    target.finish();
-    return r;
+    return step_scene<3>(target, s, cfl, h, c, n_steps);
   }
 } // namespace mpm_test
