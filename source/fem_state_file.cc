@@ -83,7 +83,7 @@ namespace mpm
     const std::size_t      n_cells    = cells.material_ids.size();
     const unsigned int     n_q        = header.quadrature_weights.size();
     AssertThrow(n_cells > 0 && cells.vertices.size() == n_cells * n_vertices * dim &&
-                  cells.states.size() == n_cells * n_q * (n_voigt + 1) &&
+                  cells.states.size() == n_cells * n_q * (n_voigt + 1 + header.n_state_variables) &&
                   header.quadrature_points.size() == n_q * dim,
                 ExcMessage("Parameter '" + entry + "': '" + file + "' is inconsistent (cell, vertex and state "
                            "counts do not match)."));
@@ -146,11 +146,13 @@ namespace mpm
         points[q][d] = header.quadrature_points[q * dim + d];
     const dealii::Quadrature<dim> quadrature(points, header.quadrature_weights);
     const QuadraturePointStateFunction<dim> state =
-      [&cells, n_q](const typename dealii::DoFHandler<dim>::active_cell_iterator &cell, const unsigned int q) {
+      [&cells, &header, n_q](const typename dealii::DoFHandler<dim>::active_cell_iterator &cell, const unsigned int q) {
         QuadraturePointState s;
-        const double        *value = &cells.states[(cell->index() * n_q + q) * (n_voigt + 1)];
+        const std::size_t    width = n_voigt + 1 + header.n_state_variables;
+        const double        *value = &cells.states[(cell->index() * n_q + q) * width];
         std::copy(value, value + n_voigt, s.stress);
         s.plastic_strain = value[n_voigt];
+        s.state_variables.assign(value + n_voigt + 1, value + width);
         return s;
       };
 

@@ -12,7 +12,7 @@
 namespace mpm
 {
   template <int dim>
-  std::vector<std::string> PropertyLayout<dim>::names()
+  std::vector<std::string> PropertyLayout<dim>::names(const std::vector<std::string> &state_variable_names)
   {
     const char *axis[3] = {"x", "y", "z"};
     const char *voigt[6] = {"xx", "yy", "zz", "xy", "yz", "xz"};
@@ -35,15 +35,16 @@ namespace mpm
     for (int d = 0; d < dim; ++d)
       n.push_back("initial_position");
     n.push_back("material_field");
+    n.insert(n.end(), state_variable_names.begin(), state_variable_names.end());
     return n;
   }
 
   template <int dim>
   std::vector<dealii::DataComponentInterpretation::DataComponentInterpretation>
-  PropertyLayout<dim>::interpretations()
+  PropertyLayout<dim>::interpretations(const unsigned int n_state_variables)
   {
     using namespace dealii::DataComponentInterpretation;
-    std::vector<DataComponentInterpretation> k(n_properties, component_is_scalar);
+    std::vector<DataComponentInterpretation> k(n_properties(n_state_variables), component_is_scalar);
     for (unsigned int d = 0; d < dim; ++d)
       {
         k[velocity + d]                   = component_is_part_of_vector;
@@ -54,9 +55,21 @@ namespace mpm
     return k;
   }
 
+  std::string state_variable_count_mismatch(const int given, const std::vector<std::string> &names)
+  {
+    std::string list;
+    for (const std::string &name : names)
+      list += (list.empty() ? "" : ", ") + name;
+    return "The material points carry " + std::to_string(given) + " state variable(s), but the run's material " +
+           "models declare " + std::to_string(names.size()) + (names.empty() ? "" : " (" + list + ")") +
+           ": every point needs a value of each (QuadraturePointState::state_variables in a hand-over).";
+  }
+
   template <int dim>
   MaterialPoints<dim>::MaterialPoints(BackgroundGrid<dim> &grid, const Parameters &parameters)
-    : handler(grid.triangulation, grid.mapping, PropertyLayout<dim>::n_properties)
+    : handler(grid.triangulation, grid.mapping,
+              PropertyLayout<dim>::n_properties(parameters.state_variable_names().size()))
+    , state_variable_names(parameters.state_variable_names())
     , grid(grid)
   {
     // Work of a cell for p4est's weighted partition (deal.II's 'weight' signal, no base
@@ -179,6 +192,8 @@ namespace mpm
             upper[dim - 1] = *std::max_element(pv.begin(), pv.end());
           }
         HostPoints<dim, double> &points = bodies[b].points;
+        const std::vector<double> initial_state = parameters.initial_state_variables(parameters.body_material[b]);
+        points.set_n_state_variables(static_cast<int>(initial_state.size()));
         add_points(points, lattice, lower, upper, description, [&](const double *x) {
           if (body.shape == "cylinder")
             return std::hypot(x[0] - body.axis[0], x[1] - body.axis[1]) <= body.radius;
@@ -201,6 +216,8 @@ namespace mpm
                 points.stress[1][i] = dim == 2 ? sv : body.k0 * sv;
                 points.stress[2][i] = dim == 2 ? body.k0 * sv : sv;
               }
+            for (std::size_t k = 0; k < initial_state.size(); ++k)
+              points.state_variables[k][i] = initial_state[k];
             points.material_field[i] = 0;
             if (field != fields.end())
               {
@@ -221,10 +238,13 @@ namespace mpm
   {
     using Layout = PropertyLayout<dim>;
     dealii::types::particle_index id = 0;
-    std::vector<double>           properties(Layout::n_properties);
+    std::vector<double>           properties(Layout::n_properties(state_variable_names.size()));
     for (const GeneratedBody<dim> &body : bodies)
       {
         const HostPoints<dim, double> &points = body.points;
+        AssertThrow(points.n_state_variables() == static_cast<int>(state_variable_names.size()),
+                    dealii::ExcMessage(state_variable_count_mismatch(points.n_state_variables(),
+                                                                     state_variable_names)));
         // One allocation of the property pool for all points (an upper bound on one rank's).
         handler.reserve(handler.n_locally_owned_particles() + points.size());
         for (int i = 0; i < points.size(); ++i, ++id)
@@ -259,6 +279,8 @@ namespace mpm
             properties[Layout::plastic_strain] = points.plastic_strain[i];
             properties[Layout::material]       = points.material[i];
             properties[Layout::material_field] = points.material_field[i];
+            for (int k = 0; k < points.n_state_variables(); ++k)
+              properties[Layout::state_variables + k] = points.state_variables[k][i];
 
             dealii::Point<dim> location;
             for (int d = 0; d < dim; ++d)
@@ -309,6 +331,7 @@ namespace mpm
       order[start[cell[g]]++] = g;
 
     p.resize(0);
+    p.set_n_state_variables(bodies.empty() ? 0 : bodies[0].points.n_state_variables());
     p.resize(n);
     labels.id.resize(n);
     for (int d = 0; d < dim; ++d)
@@ -341,6 +364,8 @@ namespace mpm
         p.plastic_strain[i] = b.plastic_strain[k];
         p.material_field[i] = b.material_field[k];
         p.material[i]       = b.material[k];
+        for (int v = 0; v < p.n_state_variables(); ++v)
+          p.state_variables[v][i] = b.state_variables[v][k];
       }
   }
 
@@ -350,12 +375,15 @@ namespace mpm
   {
     using Layout = PropertyLayout<dim>;
     const unsigned int n = handler.n_locally_owned_particles();
+    const int          n_state = static_cast<int>(state_variable_names.size());
     p.resize(0);
+    p.set_n_state_variables(n_state);
     p.resize(n);
     if (home_cells)
       home_cells->resize(n);
     if (labels)
       {
+        labels->state_variable_names = state_variable_names;
         labels->id.resize(n);
         for (int d = 0; d < dim; ++d)
           labels->initial_position[d].resize(n);
@@ -399,6 +427,8 @@ namespace mpm
         p.plastic_strain[i] = prop[Layout::plastic_strain];
         p.material_field[i] = prop[Layout::material_field];
         p.material[i]       = static_cast<int>(prop[Layout::material]);
+        for (int k = 0; k < n_state; ++k)
+          p.state_variables[k][i] = prop[Layout::state_variables + k];
         ++i;
       }
   }
@@ -430,13 +460,17 @@ namespace mpm
     values[Layout::plastic_strain] = p.plastic_strain[i];
     values[Layout::material]       = p.material[i];
     values[Layout::material_field] = p.material_field[i];
+    for (int k = 0; k < p.n_state_variables(); ++k)
+      values[Layout::state_variables + k] = p.state_variables[k][i];
   }
 
   template <int dim>
   void MaterialPoints<dim>::replace(const PointSnapshot<dim> &all)
   {
+    AssertThrow(all.points.n_state_variables() == static_cast<int>(state_variable_names.size()),
+                dealii::ExcMessage(state_variable_count_mismatch(all.points.n_state_variables(), state_variable_names)));
     handler.clear_particles();
-    std::vector<double> properties(PropertyLayout<dim>::n_properties);
+    std::vector<double> properties(PropertyLayout<dim>::n_properties(state_variable_names.size()));
     for (int i = 0; i < all.points.size(); ++i)
       {
         if (all.points.material[i] < 0)
@@ -460,6 +494,8 @@ namespace mpm
   unsigned int MaterialPoints<dim>::copy_from(const HostPoints<dim, double> &p)
   {
     using Layout = PropertyLayout<dim>;
+    AssertThrow(p.n_state_variables() == static_cast<int>(state_variable_names.size()),
+                dealii::ExcMessage(state_variable_count_mismatch(p.n_state_variables(), state_variable_names)));
     std::vector<typename dealii::Particles::ParticleHandler<dim>::particle_iterator> removed;
     int i = 0;
     for (auto particle = handler.begin(); particle != handler.end(); ++particle, ++i)
@@ -486,6 +522,8 @@ namespace mpm
           prop[Layout::deformation_gradient + c] = p.deformation_gradient[c][i];
         prop[Layout::volume]         = p.volume[i];
         prop[Layout::plastic_strain] = p.plastic_strain[i];
+        for (int k = 0; k < p.n_state_variables(); ++k)
+          prop[Layout::state_variables + k] = p.state_variables[k][i];
         particle->set_location(x);
         if (grid.n_ranks > 1 && grid.owned_cell(grid.lattice_cell_of(&x[0])) == grid.triangulation.end())
           ++n_sent; // now in another rank's cell (a point on a shared face may stay)

@@ -92,7 +92,7 @@ namespace mpm
     {
       std::ofstream table(file_name);
       AssertThrow(table, dealii::ExcMessage("Parameter 'Output/Directory': cannot write '" + file_name + "'."));
-      const auto names = PropertyLayout<dim>::names();
+      const auto names = PropertyLayout<dim>::names(snapshot.labels->state_variable_names);
       table << "id";
       for (int d = 0; d < dim; ++d)
         table << ",position_" << "xyz"[d];
@@ -112,7 +112,7 @@ namespace mpm
         }
       table << '\n' << std::setprecision(17);
       const auto         &p = snapshot.points;
-      std::vector<double> values(PropertyLayout<dim>::n_properties);
+      std::vector<double> values(PropertyLayout<dim>::n_properties(p.n_state_variables()));
       for (int i = 0; i < p.size(); ++i)
         {
           if (p.material[i] < 0)
@@ -184,7 +184,8 @@ namespace mpm
   void PointDataOut<dim>::build_patches(const PointSnapshot<dim> &snapshot, const int begin, const int end)
   {
     const auto        &p            = snapshot.points;
-    const unsigned int n_properties = PropertyLayout<dim>::n_properties;
+    const unsigned int n_properties = PropertyLayout<dim>::n_properties(p.n_state_variables());
+    state_variable_names            = snapshot.labels->state_variable_names;
     const int          last         = end < 0 ? p.size() : end;
     unsigned int       n            = 0;
     for (int i = begin; i < last; ++i)
@@ -214,7 +215,7 @@ namespace mpm
   std::vector<std::string> PointDataOut<dim>::get_dataset_names() const
   {
     std::vector<std::string> names = {"id"};
-    for (const auto &name : PropertyLayout<dim>::names())
+    for (const auto &name : PropertyLayout<dim>::names(state_variable_names))
       names.push_back(name);
     return names;
   }
@@ -226,7 +227,7 @@ namespace mpm
     using namespace dealii::DataComponentInterpretation;
     const auto names = get_dataset_names();
     std::vector<DataComponentInterpretation> kinds = {component_is_scalar};
-    for (const auto kind : PropertyLayout<dim>::interpretations())
+    for (const auto kind : PropertyLayout<dim>::interpretations(state_variable_names.size()))
       kinds.push_back(kind);
     Ranges ranges;
     for (unsigned int i = 0; i < names.size();)

@@ -414,6 +414,19 @@ namespace mpm
             fail("Material " + name + "/" + model, info.str());
           }
         prm.leave_subsection();
+        if (const UserConstitutiveModel *user = materials.back().user_model)
+          {
+            const std::vector<StateVariable> variables = user->state_variables();
+            if (variables.size() > static_cast<std::size_t>(max_state_variables))
+              fail("Material " + name + "/Model", "the model '" + model + "' declares " +
+                                                    std::to_string(variables.size()) + " state variables; at most " +
+                                                    std::to_string(max_state_variables) + " are allowed.");
+            for (const StateVariable &v : variables)
+              if (v.name.empty() || v.name.find_first_of(" ,") != std::string::npos)
+                fail("Material " + name + "/Model", "the model '" + model + "' declares a state variable named '" +
+                                                      v.name + "'; names must be non-empty, without spaces or commas "
+                                                      "(they name output fields).");
+          }
 
         // The random field: its mean is the material's own value of the parameter.
         prm.enter_subsection("Random field");
@@ -621,6 +634,34 @@ namespace mpm
           fail("Backend/Backend", "cuda cannot run material '" + material_names[i] + "': its model '" +
                                     material_models[i] + "' is defined outside the library and runs on the "
                                     "CPU backend only (Backend = cpu).");
+  }
+
+  std::vector<std::string> Parameters::state_variable_names() const
+  {
+    std::vector<std::string> names;
+    for (const MaterialParameters<double> &m : materials)
+      if (m.user_model != nullptr)
+        {
+          const std::vector<StateVariable> variables = m.user_model->state_variables();
+          for (std::size_t k = 0; k < variables.size(); ++k)
+            if (k == names.size())
+              names.push_back(variables[k].name);
+            else if (names[k] != variables[k].name)
+              names[k] = "state_variable_" + std::to_string(k); // two models, two meanings
+        }
+    return names;
+  }
+
+  std::vector<double> Parameters::initial_state_variables(const unsigned int material) const
+  {
+    std::vector<double> values(state_variable_names().size(), 0.0);
+    if (const UserConstitutiveModel *user = materials.at(material).user_model)
+      {
+        const std::vector<StateVariable> variables = user->state_variables();
+        for (std::size_t k = 0; k < variables.size(); ++k)
+          values[k] = variables[k].initial_value;
+      }
+    return values;
   }
 
   namespace

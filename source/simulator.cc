@@ -430,10 +430,11 @@ namespace mpm
     template <int dim>
     std::vector<GeneratedBody<dim>> gather_bodies(const std::vector<GeneratedBody<dim>> &local, MPI_Comm comm)
     {
-      std::vector<double> packed; // per body: its number of points, then every array of HostPoints
+      std::vector<double> packed; // per body: its numbers of points and state variables, every array
       for (const GeneratedBody<dim> &body : local)
         {
           packed.push_back(body.points.size());
+          packed.push_back(body.points.n_state_variables());
           for_each_point_array<dim>(body.points, body.points,
                                     [&](const auto &array, const auto &) { packed.insert(packed.end(), array.begin(), array.end()); });
         }
@@ -442,7 +443,9 @@ namespace mpm
         for (std::size_t at = 0; at < from_rank.size();)
           {
             GeneratedBody<dim> body;
-            body.points.resize(static_cast<int>(from_rank[at++]));
+            const int          n_points = static_cast<int>(from_rank[at++]);
+            body.points.set_n_state_variables(static_cast<int>(from_rank[at++]));
+            body.points.resize(n_points);
             for_each_point_array<dim>(body.points, body.points, [&](auto &array, auto &) {
               using T = typename std::decay_t<decltype(array)>::value_type;
               for (auto &value : array)
@@ -487,11 +490,26 @@ namespace mpm
         }
       std::vector<GeneratedBody<dim>> one(1);
       HostPoints<dim, double>        &to = one[0].points;
+      for (const GeneratedBody<dim> &body : bodies) // an empty body (a rank without cells) may hold none
+        if (body.points.size() > 0)
+          to.set_n_state_variables(body.points.n_state_variables());
       to.resize(static_cast<int>(source.size()));
       for (std::size_t k = 0; k < source.size(); ++k)
         for_each_point_array<dim>(to, bodies[source[k].first].points,
                                   [&](auto &destination, const auto &origin) { destination[k] = origin[source[k].second]; });
       return one;
+    }
+
+    // Points given to setup() carry the state variables of the run's models (an empty body,
+    // from a rank without FEM cells, may carry none).
+    template <int dim>
+    void check_state_variable_count(const std::vector<GeneratedBody<dim>> &bodies, const Parameters &p)
+    {
+      const std::vector<std::string> names = p.state_variable_names();
+      for (const GeneratedBody<dim> &body : bodies)
+        AssertThrow(body.points.size() == 0 || body.points.n_state_variables() == static_cast<int>(names.size()),
+                    dealii::ExcMessage("The material points handed over: " +
+                                       state_variable_count_mismatch(body.points.n_state_variables(), names)));
     }
 
     // Points given to setup(): inside the grid, a material of the prm, a positive mass and volume.
@@ -556,6 +574,7 @@ namespace mpm
       {
         if (s.parallel)
           *given_bodies = gather_bodies(*given_bodies, s.communicator);
+        check_state_variable_count(*given_bodies, parameters);
         *given_bodies = in_canonical_order(*given_bodies);
         check_given_points(*given_bodies, parameters);
         // GIMP's particle domains stay within half a cell, and inside the grid: a domain that
@@ -644,6 +663,7 @@ namespace mpm
         HostPoints<dim, double> host;
         auto                    labels = std::make_shared<PointLabels<dim>>();
         points_of_bodies(generation.get(), lattice_geometry<dim>(parameters), host, *labels);
+        labels->state_variable_names = parameters.state_variable_names();
         if (cuda_ready.valid())
           cuda_ready.get();
         s.engine = make_engine<dim>(parameters.backend, lattice_grid<dim>(parameters), s.materials,
@@ -906,6 +926,10 @@ namespace mpm
     // gets handed-over points) and keeps those in its cells, ids and labels kept.
     dealii::TimerOutput::Scope scope(s.timer, "migrate points");
     std::vector<double>        packed{double(new_points.size())};
+    AssertThrow(new_points.n_state_variables() == snapshot.points.n_state_variables(),
+                dealii::ExcMessage("Simulator::set_points(): " + state_variable_count_mismatch(
+                                                                  new_points.n_state_variables(),
+                                                                  snapshot.labels->state_variable_names)));
     for_each_point_array<dim>(new_points, new_points, [&](const auto &array, const auto &) {
       packed.insert(packed.end(), array.begin(), array.end());
     });
@@ -919,6 +943,8 @@ namespace mpm
       total += static_cast<int>(from_rank[0]);
     PointSnapshot<dim> all;
     auto               labels = std::make_shared<PointLabels<dim>>();
+    labels->state_variable_names = snapshot.labels->state_variable_names;
+    all.points.set_n_state_variables(new_points.n_state_variables());
     all.points.resize(total);
     int offset = 0;
     for (const std::vector<double> &from_rank : ranks)

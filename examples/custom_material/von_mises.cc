@@ -58,7 +58,7 @@ namespace
     // to the surface. The plastic strain counts the equivalent plastic strain
     // sqrt(2/3 de_p : de_p) of the return.
     void update_stress(const mpm::SymTensor<double> &d_eps, const mpm::Mat3<double> &d_spin, const bool plastic,
-                       mpm::SymTensor<double> &stress, double &plastic_strain) const override
+                       mpm::SymTensor<double> &stress, double &plastic_strain, double *) const override
     {
       const mpm::SymTensor<double> rotated = mpm::rotate_jaumann(stress, d_spin);
       const mpm::SymTensor<double> d_sigma = mpm::elastic_stress_increment(elastic, d_eps);

@@ -2,7 +2,8 @@
 // output_writer.h) is the same file as deal.II's Particles::DataOut writes from the
 // ParticleHandler after a hand-over, byte for byte (date line off), in 2D and 3D:
 //  - every property set to a distinct value per point and property (so that a swapped
-//    or missing property in PointSnapshot::properties changes the file);
+//    or missing property in PointSnapshot::properties changes the file), two state
+//    variables of a user model among them;
 //  - a point that left the grid (material < 0 in the engine) is missing from the patches,
 //    as it is from the handler after the hand-over removes it (same patches by id);
 //  - the .pvtu records are the same;
@@ -12,6 +13,7 @@
 // for the nodal vectors and the rank as cell data, byte for byte, and their pieces add up
 // to the whole.
 // Runs on any number of MPI ranks (each rank compares its own piece).
+#include <mpm/dealii/material_library.h>
 #include <mpm/dealii/material_points.h>
 #include <mpm/dealii/output_writer.h>
 
@@ -64,13 +66,24 @@ namespace
     return same;
   }
 
+  // A user model whose points carry two state variables (their values are set by hand here).
+  class TwoStateVariables : public UserConstitutiveModel
+  {
+  public:
+    std::vector<StateVariable> state_variables() const override { return {{"void_ratio", 0.6}, {"damage", 0}}; }
+    void update_stress(const SymTensor<double> &, const Mat3<double> &, bool, SymTensor<double> &, double &,
+                       double *) const override
+    {}
+    LinearElasticParameters<double> elastic_parameters() const override { return {1e6, 0.3}; }
+  };
+
   template <int dim>
   Parameters scene()
   {
     Parameters p      = mpm_test::box_domain<dim>(0.08, 0.01);
     p.bodies          = {mpm_test::box_body<dim>(0.01, 0.05, 2, 2000)};
     p.body_material   = {0};
-    p.materials.resize(1);
+    p.materials       = {user_defined_material(std::make_shared<TwoStateVariables>())};
     p.material_fields.resize(1);
     return p;
   }
@@ -143,20 +156,23 @@ namespace
     MaterialPoints<dim> points(grid, parameters);
     points.generate(parameters);
     using Layout = PropertyLayout<dim>;
+    const std::vector<std::string> &state_names = points.state_variable_names;
+    mpm_test::check(state_names == std::vector<std::string>{"void_ratio", "damage"},
+                    "the points carry the model's two state variables");
 
     // Distinct values: point id and property index both show in each value; the
     // material id stays an integer (the engine holds it as int).
     for (auto &particle : points.handler)
       {
         auto properties = particle.get_properties();
-        for (unsigned int k = 0; k < Layout::n_properties; ++k)
+        for (unsigned int k = 0; k < Layout::n_properties(state_names.size()); ++k)
           properties[k] = 1000.0 * (k + 1) + 0.37 * particle.get_id() + 1e-3 * k * k;
         properties[Layout::material] = 3;
       }
 
     // Old path: the handler through Particles::DataOut.
     dealii::Particles::DataOut<dim> from_handler;
-    from_handler.build_patches(points.handler, Layout::names(), Layout::interpretations());
+    from_handler.build_patches(points.handler, Layout::names(state_names), Layout::interpretations(state_names.size()));
     // New path: the core's arrays (as the engine loads them) through PointDataOut.
     PointSnapshot<dim> snapshot;
     auto               labels = std::make_shared<PointLabels<dim>>();
@@ -195,7 +211,7 @@ namespace
     std::advance(it, gone);
     points.handler.remove_particle(it);
     Exposed<dealii::Particles::DataOut<dim>> from_handler_after;
-    from_handler_after.build_patches(points.handler, Layout::names(), Layout::interpretations());
+    from_handler_after.build_patches(points.handler, Layout::names(state_names), Layout::interpretations(state_names.size()));
     Exposed<PointDataOut<dim>> from_snapshot_after;
     from_snapshot_after.build_patches(snapshot);
     const auto old_patches = by_id(from_handler_after.get_patches());

@@ -43,7 +43,7 @@ namespace
     }
     LinearElasticParameters<double> elastic_parameters() const override { return elastic; }
     void update_stress(const SymTensor<double> &d_eps, const Mat3<double> &d_spin, const bool plastic,
-                       SymTensor<double> &stress, double &plastic_strain) const override
+                       SymTensor<double> &stress, double &plastic_strain, double *) const override
     {
       drucker_prager_update(elastic, model, plastic, d_eps, d_spin, stress, plastic_strain);
     }

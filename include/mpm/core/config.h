@@ -14,4 +14,8 @@ namespace mpm
   // plane strain keeps sigma_zz, which plasticity needs.
   // Order: xx, yy, zz, xy, yz, xz.
   constexpr int n_voigt = 6;
+
+  // State variables of one point besides stress and plastic strain, at most: those a
+  // constitutive model written outside the library declares (user_model.h).
+  constexpr int max_state_variables = 16;
 } // namespace mpm

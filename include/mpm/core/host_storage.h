@@ -5,10 +5,22 @@
 #include <mpm/core/views.h>
 
 #include <cstdint>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
 namespace mpm
 {
+  // Whether an owner of point arrays holds state variables (HostPoints does; the CUDA
+  // backend's DevicePoints does not: user models, the only ones with any, run on the CPU).
+  template <typename Storage, typename = void>
+  struct has_state_variables : std::false_type
+  {};
+  template <typename Storage>
+  struct has_state_variables<Storage, std::void_t<decltype(std::declval<Storage &>().state_variables)>>
+    : std::true_type
+  {};
+
   // The view of any owner of point arrays (HostPoints, the CUDA backend's DevicePoints):
   // arrays with .data() under the member names of HostPoints.
   template <int dim, typename Real, typename Storage>
@@ -36,11 +48,18 @@ namespace mpm
     v.plastic_strain = s.plastic_strain.data();
     v.material_field = s.material_field.data();
     v.material       = s.material.data();
+    if constexpr (has_state_variables<Storage>::value)
+      {
+        v.n_state_variables = static_cast<int>(s.state_variables.size());
+        for (int k = 0; k < v.n_state_variables; ++k)
+          v.state_variables[k] = s.state_variables[k].data();
+      }
     return v;
   }
 
   // Visits the matching arrays of two owners of point arrays (HostPoints, DevicePoints,
   // or one owner twice) as f(array of a, array of b): upload, download, permutation.
+  // State variables are visited where both hold them, a's count of them (b has as many).
   template <int dim, typename A, typename B, typename F>
   void for_each_point_array(A &a, B &b, F &&f)
   {
@@ -64,6 +83,9 @@ namespace mpm
     f(a.plastic_strain, b.plastic_strain);
     f(a.material_field, b.material_field);
     f(a.material, b.material);
+    if constexpr (has_state_variables<std::decay_t<A>>::value && has_state_variables<std::decay_t<B>>::value)
+      for (std::size_t k = 0; k < a.state_variables.size(); ++k)
+        f(a.state_variables[k], b.state_variables[k]);
   }
 
   template <int dim, typename Real>
@@ -73,8 +95,20 @@ namespace mpm
       strain[n_voigt], deformation_gradient[dim * dim], domain_half_length[dim], initial_domain_half_length[dim], plastic_strain,
       material_field;
     std::vector<int> material;
+    // The user models' state variables (PointsView::state_variables): one array per
+    // variable, none unless a model of the run declares some.
+    std::vector<std::vector<Real>> state_variables;
 
     int size() const { return static_cast<int>(mass.size()); }
+    int n_state_variables() const { return static_cast<int>(state_variables.size()); }
+
+    // Holds n state variable arrays (of the current size); resize() keeps their number.
+    void set_n_state_variables(const int n)
+    {
+      state_variables.resize(n);
+      for (auto &array : state_variables)
+        array.resize(mass.size());
+    }
 
     void resize(const int n)
     {
@@ -98,6 +132,8 @@ namespace mpm
       plastic_strain.resize(n);
       material_field.resize(n);
       material.resize(n);
+      for (auto &array : state_variables)
+        array.resize(n);
     }
 
     PointsView<dim, Real> view() { return make_points_view<dim, Real>(*this); }

@@ -632,6 +632,14 @@ namespace mpm
             for (int c = 0; c < n_voigt; ++c)
               state.stress[c] = p.stress[c][i];
             state.plastic_strain = p.plastic_strain[i];
+#ifndef __CUDA_ARCH__
+            // A user model's state variables (CPU only: the GPU runs built-in models).
+            Real variables[max_state_variables];
+            for (int k = 0; k < p.n_state_variables; ++k)
+              variables[k] = p.state_variables[k][i];
+            if (p.n_state_variables > 0)
+              state.state_variables = variables;
+#endif
             const MaterialParameters<Real> &material = materials[p.material[i]];
             if (material.field_parameter == FieldParameter::none)
               update_stress(material, d_eps, dW, state);
@@ -643,6 +651,10 @@ namespace mpm
                 p.strain[c][i] += d_eps[c];
               }
             p.plastic_strain[i] = state.plastic_strain;
+#ifndef __CUDA_ARCH__
+            for (int k = 0; k < p.n_state_variables; ++k)
+              p.state_variables[k][i] = variables[k];
+#endif
           }
 
         if (s.domain_update != DomainUpdate::none && move)

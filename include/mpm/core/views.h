@@ -101,5 +101,9 @@ namespace mpm
     Real *plastic_strain;                  // accumulated equivalent plastic strain
     Real *material_field;                  // per-point value of the material's random-field parameter
     int  *material;
+    // State variables of user models (user_model.h): variable k of point i is
+    // state_variables[k][i]. None (0) unless a model of the run declares some; never on the GPU.
+    Real *state_variables[max_state_variables] = {};
+    int   n_state_variables                     = 0;
   };
 } // namespace mpm

@@ -10,7 +10,7 @@
 // Placement (a): one material point per quadrature point of every locally owned cell, in the
 // deformed configuration: position x = X + u(X), deformation gradient F = I + grad u, volume
 // det(F) JxW, mass = density JxW (JxW in the mesh's reference configuration), small strain
-// sym(grad u), and the quadrature point's stress and plastic strain. The MPM background grid
+// sym(grad u), and the quadrature point's stress, plastic strain and state variables. The MPM background grid
 // is the prm's (Grid), independent of the FEM mesh; points outside it are refused by setup().
 // Placement (b), points on the MPM's lattice with the state projected: fem_handover_lattice.h.
 // Header-only: it is instantiated for the user's vector type.
@@ -45,6 +45,10 @@ namespace mpm
     double stress[n_voigt] = {0, 0, 0, 0, 0, 0};
     // Accumulated equivalent plastic strain (softening reads it).
     double plastic_strain = 0;
+    // The further state variables of the MPM material's model, in the order its
+    // state_variables() lists them (user_model.h); empty for the built-in models. Every
+    // quadrature point gives as many as the run's models declare (Parameters::state_variable_names).
+    std::vector<double> state_variables;
   };
 
   // What the cells of one material_id of the FEM mesh become in the MPM.
@@ -87,6 +91,22 @@ namespace mpm
                       dealii::Utilities::MPI::n_mpi_processes(dof_handler.get_communicator()) == 1,
                     dealii::ExcMessage("FEM hand-over: the displacement vector must hold ghost values (a vector "
                                        "initialised with the locally relevant DoFs) on several MPI ranks."));
+    }
+
+    // The state variables of one quadrature point into point i; the first point fixes their
+    // number, every other must give as many.
+    template <int dim>
+    void set_state_variables(HostPoints<dim, double> &p, const int i, const std::vector<double> &values,
+                             const std::string &where)
+    {
+      if (i == 0)
+        p.set_n_state_variables(static_cast<int>(values.size()));
+      AssertThrow(static_cast<int>(values.size()) == p.n_state_variables(),
+                  dealii::ExcMessage("FEM hand-over: " + where + " gives " + std::to_string(values.size()) +
+                                     " state variable(s), the first quadrature point " +
+                                     std::to_string(p.n_state_variables()) + "."));
+      for (int k = 0; k < p.n_state_variables(); ++k)
+        p.state_variables[k][i] = values[k];
     }
 
     // Small strain sym(grad u) of point i, Voigt xx, yy, zz, xy, yz, xz with tensor shear components.
@@ -187,6 +207,8 @@ namespace mpm
             if (dim == 2)
               p.stress[4][i] = p.stress[5][i] = 0; // plane strain: no out-of-plane shear
             p.plastic_strain[i] = s.plastic_strain;
+            internal::set_state_variables(p, i, s.state_variables,
+                                          "quadrature point " + std::to_string(q) + " of cell " + cell->id().to_string());
             p.initial_volume[i] = V0;
             p.volume[i]         = J * V0;
             p.mass[i]           = material.density * V0;

@@ -8,10 +8,11 @@
 //
 // Every lattice point x inside the deformed FEM body (x = X + u(X) for some X of a cell) becomes a
 // material point at x: volume (h/n)^dim, deformation gradient F = I + grad u at X, mass
-// density * (h/n)^dim / det F, small strain sym(grad u). Stress and plastic strain come from the
-// quadrature points of X's cell by a cell-wise L2 projection onto discontinuous polynomials of
-// degree k (FE_DGQ(k); the DG mass matrix is cell-local, so no global solve), evaluated at X; a
-// plastic strain that the projection takes below zero is set to zero.
+// density * (h/n)^dim / det F, small strain sym(grad u). Stress, plastic strain and the model's
+// further state variables come from the quadrature points of X's cell by a cell-wise L2
+// projection onto discontinuous polynomials of degree k (FE_DGQ(k); the DG mass matrix is
+// cell-local, so no global solve), evaluated at X; a plastic strain that the projection takes
+// below zero is set to zero.
 // A point on the boundary between cells takes the cell with the smallest CellId, so that the
 // points do not depend on how the mesh is partitioned; each rank returns the points of its own
 // cells (Simulator::setup gathers them).
@@ -184,11 +185,17 @@ namespace mpm
     GeneratedBody<dim>       body;
     HostPoints<dim, double> &p = body.points;
     p.resize(static_cast<int>(n_points));
+    // The state variables: as many as the first quadrature point of this rank's cells gives.
+    if (!by_cell.empty())
+      p.set_n_state_variables(static_cast<int>(state(cell_of.begin()->second, 0).state_variables.size()));
+    const int n_state = p.n_state_variables();
+    // Projected components: 6 stresses, the plastic strain, the state variables.
+    const int                                n_components = n_voigt + 1 + n_state;
     const dealii::FEValuesExtractors::Vector u(0);
     const double                             volume = std::pow(dx, dim);
     int                                      i      = 0;
     dealii::FullMatrix<double>               mass(n_dg, n_dg), inverse(n_dg, n_dg);
-    std::vector<std::array<double, n_voigt + 1>> coefficients(n_dg);
+    std::vector<std::vector<double>>         coefficients(n_dg, std::vector<double>(n_components));
     for (const auto &[id, units] : by_cell)
       {
         const auto &cell  = cell_of.at(id);
@@ -198,24 +205,29 @@ namespace mpm
                                std::to_string(int(cell->material_id())) +
                                ", which the map of materials given to the hand-over does not name."));
 
-        // The projection of the cell's quadrature-point state (6 stresses, plastic strain).
+        // The projection of the cell's quadrature-point state (6 stresses, plastic strain, state variables).
         fe_values.reinit(cell);
         mass = 0;
         for (auto &c : coefficients)
-          c.fill(0);
-        std::vector<std::array<double, n_voigt + 1>> rhs(n_dg);
-        for (auto &r : rhs)
-          r.fill(0);
+          std::fill(c.begin(), c.end(), 0.0);
+        std::vector<std::vector<double>> rhs(n_dg, std::vector<double>(n_components, 0.0));
         for (unsigned int q = 0; q < n_q; ++q)
           {
             const QuadraturePointState s = state(cell, q);
+            AssertThrow(static_cast<int>(s.state_variables.size()) == n_state,
+                        ExcMessage("FEM hand-over: quadrature point " + std::to_string(q) + " of cell " +
+                                   id.to_string() + " gives " + std::to_string(s.state_variables.size()) +
+                                   " state variable(s), the first quadrature point " + std::to_string(n_state) + "."));
             for (unsigned int a = 0; a < n_dg; ++a)
               {
+                const double weight = phi(q, a) * fe_values.JxW(q);
                 for (unsigned int b = 0; b < n_dg; ++b)
                   mass(a, b) += phi(q, a) * phi(q, b) * fe_values.JxW(q);
                 for (int c = 0; c < n_voigt; ++c)
-                  rhs[a][c] += phi(q, a) * s.stress[c] * fe_values.JxW(q);
-                rhs[a][n_voigt] += phi(q, a) * s.plastic_strain * fe_values.JxW(q);
+                  rhs[a][c] += weight * s.stress[c];
+                rhs[a][n_voigt] += weight * s.plastic_strain;
+                for (int k = 0; k < n_state; ++k)
+                  rhs[a][n_voigt + 1 + k] += weight * s.state_variables[k];
               }
           }
         inverse.invert(mass);
@@ -239,7 +251,7 @@ namespace mpm
                                "a Gauss rule with degree + 1 points per direction."));
         for (unsigned int a = 0; a < n_dg; ++a)
           for (unsigned int b = 0; b < n_dg; ++b)
-            for (int c = 0; c <= n_voigt; ++c)
+            for (int c = 0; c < n_components; ++c)
               coefficients[a][c] += inverse(a, b) * rhs[b][c];
 
         // The kinematics at the points' reference positions, on the undeformed cell.
@@ -270,11 +282,11 @@ namespace mpm
                   p.deformation_gradient[d * dim + e][i] = F[d][e];
               }
             internal::set_small_strain(p, i, grad_u_p[j]);
-            double values[n_voigt + 1] = {};
+            std::vector<double> values(n_components, 0.0);
             for (unsigned int a = 0; a < n_dg; ++a)
               {
                 const double phi_a = dg.shape_value(a, units[j]);
-                for (int c = 0; c <= n_voigt; ++c)
+                for (int c = 0; c < n_components; ++c)
                   values[c] += coefficients[a][c] * phi_a;
               }
             for (int c = 0; c < n_voigt; ++c)
@@ -283,6 +295,9 @@ namespace mpm
               p.stress[4][i] = p.stress[5][i] = 0; // plane strain: no out-of-plane shear
             // The projection may overshoot below zero next to a yielded region; eps_p >= 0.
             p.plastic_strain[i] = std::max(0.0, values[n_voigt]);
+            // State variables as projected: their bounds, if any, are the model's to know.
+            for (int k = 0; k < n_state; ++k)
+              p.state_variables[k][i] = values[n_voigt + 1 + k];
             p.initial_volume[i] = volume / J;
             p.volume[i]         = volume;
             p.mass[i]           = match->second.density * volume / J;

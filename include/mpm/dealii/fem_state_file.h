@@ -27,8 +27,11 @@
 #include <mpm/dealii/fem_handover.h>
 #include <mpm/dealii/parameters.h>
 
+#include <deal.II/base/mpi.h>
 #include <deal.II/dofs/dof_handler.h>
 #include <deal.II/lac/vector.h>
+
+#include <boost/serialization/version.hpp>
 
 #include <mpi.h>
 
@@ -43,7 +46,7 @@ namespace mpm
     std::vector<double>       vertices;    // per cell: vertices_per_cell points of dim coordinates
     std::vector<unsigned int> material_ids; // per cell
     std::vector<double>       dof_values;  // per cell: the FE's dofs_per_cell values of the displacement
-    std::vector<double>       states;      // per cell: n_q x (n_voigt stresses, plastic strain)
+    std::vector<double>       states;      // per cell: n_q x (n_voigt stresses, plastic strain, state variables)
 
     template <class Archive>
     void serialize(Archive &ar, const unsigned int)
@@ -59,11 +62,15 @@ namespace mpm
     std::string         fe_name;
     std::vector<double> quadrature_points; // n_q x dim
     std::vector<double> quadrature_weights;
+    unsigned int        n_state_variables = 0; // per quadrature point, besides stress and eps_p
 
+    // Version 1 added the state variables; a version 0 file has none.
     template <class Archive>
-    void serialize(Archive &ar, const unsigned int)
+    void serialize(Archive &ar, const unsigned int version)
     {
       ar &dim &fe_name &quadrature_points &quadrature_weights;
+      if (version >= 1)
+        ar &n_state_variables;
     }
   };
 
@@ -94,6 +101,8 @@ namespace mpm
       }
     FemStateCells          cells;
     dealii::Vector<double> local(dof_handler.get_fe().n_dofs_per_cell());
+    bool                   first = true;
+    std::string            mismatch; // what is wrong with this rank's state, if anything
     for (const auto &cell : dof_handler.active_cell_iterators())
       if (cell->is_locally_owned())
         {
@@ -106,11 +115,32 @@ namespace mpm
           for (unsigned int q = 0; q < quadrature.size(); ++q)
             {
               const QuadraturePointState s = state(cell, q);
+              if (first)
+                header.n_state_variables = s.state_variables.size();
+              first = false;
+              if (s.state_variables.size() != header.n_state_variables && mismatch.empty())
+                mismatch = "quadrature point " + std::to_string(q) + " of cell " + cell->id().to_string() +
+                           " gives " + std::to_string(s.state_variables.size()) +
+                           " state variable(s), the first quadrature point " +
+                           std::to_string(header.n_state_variables) + ".";
               cells.states.insert(cells.states.end(), s.stress, s.stress + n_voigt);
               cells.states.push_back(s.plastic_strain);
+              cells.states.insert(cells.states.end(), s.state_variables.begin(), s.state_variables.end());
             }
         }
-    write_fem_state_file(filename, header, cells, dof_handler.get_communicator());
+    // One count on every rank (a rank without cells takes the others'); a refusal on any rank
+    // stops every rank before the collective write.
+    const MPI_Comm     comm = dof_handler.get_communicator();
+    const unsigned int most = dealii::Utilities::MPI::max(header.n_state_variables, comm);
+    if (!first && header.n_state_variables != most && mismatch.empty())
+      mismatch = "the MPI ranks' quadrature points give different numbers of state variables (" +
+                 std::to_string(header.n_state_variables) + " here, " + std::to_string(most) + " elsewhere).";
+    header.n_state_variables = most;
+    const bool refused_anywhere = dealii::Utilities::MPI::max(mismatch.empty() ? 0 : 1, comm) > 0;
+    AssertThrow(mismatch.empty(), dealii::ExcMessage("save_fem_state: " + mismatch));
+    AssertThrow(!refused_anywhere, dealii::ExcMessage("save_fem_state: another MPI rank's state was refused (its "
+                                                      "message says why)."));
+    write_fem_state_file(filename, header, cells, comm);
   }
 
   // The same with the states in deal.II's CellDataStorage.
@@ -127,3 +157,5 @@ namespace mpm
   template <int dim>
   std::vector<GeneratedBody<dim>> load_fem_state_points(const Parameters &parameters, MPI_Comm communicator);
 } // namespace mpm
+
+BOOST_CLASS_VERSION(mpm::FemStateHeader, 1)

@@ -36,10 +36,16 @@ namespace mpm
     static constexpr unsigned int material             = plastic_strain + 1;
     static constexpr unsigned int initial_position     = material + 1;
     static constexpr unsigned int material_field       = initial_position + dim;
-    static constexpr unsigned int n_properties         = material_field + 1;
+    // Then one per state variable of the run's models (Parameters::state_variable_names).
+    static constexpr unsigned int state_variables      = material_field + 1;
 
-    static std::vector<std::string> names();
-    static std::vector<dealii::DataComponentInterpretation::DataComponentInterpretation> interpretations();
+    static constexpr unsigned int n_properties(const unsigned int n_state_variables)
+    {
+      return state_variables + n_state_variables;
+    }
+    static std::vector<std::string> names(const std::vector<std::string> &state_variable_names = {});
+    static std::vector<dealii::DataComponentInterpretation::DataComponentInterpretation>
+    interpretations(unsigned int n_state_variables = 0);
   };
 
   // What the core's arrays do not hold but output needs, per point in the engine's
@@ -50,6 +56,8 @@ namespace mpm
   {
     std::vector<dealii::types::particle_index> id;
     std::vector<double>                        initial_position[dim];
+    // The names of the points' state variables (PropertyLayout::state_variables on).
+    std::vector<std::string> state_variable_names;
   };
 
   // A copy of the points as the engine holds them at one time, for output without a
@@ -65,6 +73,9 @@ namespace mpm
     // handler would hold after a hand-over.
     void properties(int i, double *values) const;
   };
+
+  // The message of points whose number of state variables is not the run's (names).
+  std::string state_variable_count_mismatch(int given, const std::vector<std::string> &names);
 
   // The points of one body with their initial stress and material field value.
   template <int dim>
@@ -132,6 +143,9 @@ namespace mpm
     dealii::types::particle_index           n_generated = 0;
     // Points this rank handed to another rank in copy_from's re-sorts, summed.
     unsigned long n_sent = 0;
+
+    // The names of the state variables every point carries (Parameters::state_variable_names).
+    const std::vector<std::string> state_variable_names;
 
   private:
     BackgroundGrid<dim> &grid;

@@ -45,6 +45,7 @@ namespace mpm
 
   private:
     std::vector<dealii::DataOutBase::Patch<0, dim>> patches;
+    std::vector<std::string>                        state_variable_names; // of the snapshot
   };
 
   // What the grid files show, copied when the output is asked for (MPI collective: the

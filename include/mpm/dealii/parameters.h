@@ -113,6 +113,13 @@ namespace mpm
     std::string backend;
     int         sort_interval = 20; // cuda: steps between re-sorts of the points on the device
 
+    // The state variables every point of the run carries (user_model.h): their names, the
+    // longest list the materials' models declare (where two models name variable k
+    // differently: state_variable_k), and the values the points of material m start with
+    // (the model's own initial values, zero beyond its list).
+    std::vector<std::string> state_variable_names() const;
+    std::vector<double>      initial_state_variables(unsigned int material) const;
+
     // Declares every entry for a given dimension, number of bodies and material names.
     static void declare(dealii::ParameterHandler &prm, unsigned int dim, unsigned int n_bodies,
                         const std::vector<std::string> &material_names);

@@ -54,6 +54,7 @@ namespace mpm
   {
     SymTensor<Real> stress;
     Real            plastic_strain;
+    Real           *state_variables = nullptr; // a user model's own (host only), null if none
   };
 
   template <typename Real>
@@ -106,7 +107,8 @@ namespace mpm
 #ifndef __CUDA_ARCH__
           // The interface is double; only the CPU backend runs user models, and it steps in double.
           if constexpr (std::is_same_v<Real, double>)
-            m.user_model->update_stress(d_eps, d_spin, m.plasticity_enabled, state.stress, state.plastic_strain);
+            m.user_model->update_stress(d_eps, d_spin, m.plasticity_enabled, state.stress, state.plastic_strain,
+                                        state.state_variables);
 #endif
           break;
         case MaterialModel::linear_elastic:
