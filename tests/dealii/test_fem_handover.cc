@@ -4,6 +4,10 @@
 //    strain sym(A), to round-off;
 //  - after Simulator::setup the run holds every point's stress and plastic strain as handed over
 //    (the quadrature-point field reproduced at the points), to 1e-12 relative;
+//  - with a user model that declares two state variables, the run holds their handed-over values
+//    at every point, unchanged, also through an FEM file (save_fem_state, then the executable's
+//    reader); points without them, or quadrature points that give different numbers of them, are
+//    refused;
 //  - bad input stops with a message that says what is wrong: a scalar FE, a material_id the map
 //    does not name, a point outside the MPM grid, a cell without quadrature-point history, a
 //    material with a random field, a displacement vector of the wrong size, the same points handed
@@ -11,6 +15,8 @@
 #include "../core/check.h"
 
 #include <mpm/dealii/fem_handover.h>
+#include <mpm/dealii/fem_state_file.h>
+#include <mpm/dealii/material_library.h>
 #include <mpm/dealii/parameters.h>
 #include <mpm/dealii/simulator.h>
 
@@ -35,6 +41,26 @@ using namespace dealii;
 using mpm_test::check;
 using mpm_test::throws_naming;
 using mpm_test::check_below;
+
+namespace
+{
+  // Elastic, with two state variables that only the hand-over sets (the run holds them).
+  class ElasticWithState : public mpm::UserConstitutiveModel
+  {
+  public:
+    static void declare_parameters(ParameterHandler &) {}
+    void        parse_parameters(ParameterHandler &) {}
+    std::vector<mpm::StateVariable> state_variables() const override { return {{"void_ratio", 0.7}, {"hardening", 0}}; }
+    mpm::LinearElasticParameters<double> elastic_parameters() const override { return {1e7, 0.3}; }
+    void update_stress(const mpm::SymTensor<double> &d_eps, const mpm::Mat3<double> &d_spin, bool,
+                       mpm::SymTensor<double> &stress, double &, double *) const override
+    {
+      mpm::linear_elastic_update(elastic_parameters(), d_eps, d_spin, stress);
+    }
+  };
+} // namespace
+
+MPM_REGISTER_CONSTITUTIVE_MODEL(ElasticWithState, "elastic with state", "A test: two state variables.");
 
 namespace
 {
@@ -65,13 +91,14 @@ namespace
   };
 
   template <int dim>
-  std::string scene()
+  std::string scene(const bool with_state_variables = false)
   {
     const std::string d3 = dim == 3 ? ", 0" : "", u3 = dim == 3 ? ", 4" : "";
     return "set Dimension = " + std::to_string(dim) +
            "\nsubsection Grid\n set Lower corner = -1, -1" + d3 + "\n set Upper corner = 5, 5" + u3 +
            "\n set Cell size = 0.5\nend\n"
-           "subsection Materials\n set Names = soil, rock\nend\n"
+           "subsection Materials\n set Names = soil, rock" + (with_state_variables ? ", clay" : "") + "\nend\n" +
+           (with_state_variables ? "subsection Material clay\n set Model = elastic with state\nend\n" : "") +
            "subsection Material soil\n set Model = linear elastic\nend\n"
            "subsection Material rock\n set Model = drucker prager\n subsection drucker prager\n  set Cohesion = 1e4\n"
            " end\n subsection Random field\n  set Parameter = cohesion\n  set Standard deviation = 1e3\n end\nend\n"
@@ -185,6 +212,77 @@ namespace
                 dim, stress / largest_stress, plastic);
     check_below(stress / largest_stress, 1e-12, "the quadrature-point stress reproduced at the points");
     check_below(plastic, 1e-15, "the plastic strain handed over");
+
+    // State variables of a user model: handed over with the points, held by the run unchanged.
+    {
+      for (const auto &cell : triangulation.active_cell_iterators())
+        for (unsigned int q = 0; q < quadrature.size(); ++q)
+          history.get_data(cell)[q]->state_variables = {0.55 + 0.01 * cell->center()[0] + 1e-4 * q,
+                                                        -3e-3 * cell->center()[1] * (q + 1)};
+      mpm::GeneratedBody<dim> clay = mpm::points_at_quadrature_points(dof_handler, u, quadrature, history, materials);
+      std::fill(clay.points.material.begin(), clay.points.material.end(), 2);
+      mpm::Simulator<dim> s(mpm::parameters_from_string(scene<dim>(true)), MPI_COMM_WORLD);
+      s.setup({clay});
+      const mpm::HostPoints<dim, double> in_run = s.points();
+      std::vector<std::pair<std::array<double, dim>, int>> placed;
+      for (int k = 0; k < in_run.size(); ++k)
+        placed.emplace_back(key(in_run, k), k);
+      std::sort(placed.begin(), placed.end());
+      double state = in_run.n_state_variables() == 2 && placed.size() == given.size() ? 0 : 1e300;
+      for (std::size_t k = 0; state == 0 && k < given.size(); ++k)
+        for (int v = 0; v < 2; ++v)
+          state = std::max(state, std::abs(in_run.state_variables[v][placed[k].second] -
+                                           clay.points.state_variables[v][given[k].second]));
+      std::printf("%dD: state variables held by the run against the quadrature points: %.2e\n", dim, state);
+      check(state == 0, "two state variables of a user model handed over exactly");
+
+      check(throws_naming([&]() {
+              mpm::Simulator<dim> r(mpm::parameters_from_string(scene<dim>(true)), MPI_COMM_WORLD);
+              r.setup({body});
+            },
+                          "carry 0 state variable(s), but the run's material models declare 2 (void_ratio, hardening)"),
+            "points without the run's state variables are refused, naming them");
+      // The same state through a file (save_fem_state, then the executable's reader with
+      // Initial state/Source = FEM file): the same points, state variables included.
+      {
+        const std::string file = "fem-handover-" + std::to_string(dim) + "d.fem-state";
+        mpm::save_fem_state(file, dof_handler, u, quadrature, history);
+        const mpm::Parameters from_file = mpm::parameters_from_string(
+          scene<dim>(true) + "subsection Initial state\n set Source = FEM file\n set FEM file = " + file +
+          "\n set Materials = 7: clay, 2000; 8: clay, 2500\nend\n");
+        const std::vector<mpm::GeneratedBody<dim>> read = mpm::load_fem_state_points<dim>(from_file, MPI_COMM_WORLD);
+        const mpm::HostPoints<dim, double>        &r    = read.at(0).points;
+        std::vector<std::pair<std::array<double, dim>, int>> loaded;
+        for (int k = 0; k < r.size(); ++k)
+          loaded.emplace_back(key(r, k), k);
+        std::sort(loaded.begin(), loaded.end());
+        double difference = r.n_state_variables() == 2 && loaded.size() == given.size() ? 0 : 1e300;
+        for (std::size_t k = 0; difference == 0 && k < given.size(); ++k)
+          {
+            const int a = loaded[k].second, b = given[k].second;
+            for (int d = 0; d < dim; ++d)
+              difference = std::max(difference, std::abs(r.position[d][a] - clay.points.position[d][b]));
+            for (int c = 0; c < mpm::n_voigt; ++c)
+              difference = std::max(difference, std::abs(r.stress[c][a] - clay.points.stress[c][b]) / largest_stress);
+            for (int v = 0; v < 2; ++v)
+              difference = std::max(difference, std::abs(r.state_variables[v][a] - clay.points.state_variables[v][b]));
+            difference = std::max(difference, std::abs(r.volume[a] - clay.points.volume[b]) / clay.points.volume[b]);
+            difference = std::max(difference, r.material[a] == 2 ? 0.0 : 1e300);
+          }
+        std::printf("%dD: FEM file against the API: largest difference %.2e (positions, stresses, state variables, "
+                    "volumes)\n",
+                    dim, difference);
+        check_below(difference, 1e-13, "the FEM file gives the API's points, state variables included");
+      }
+
+      history.get_data(triangulation.last_active())[1]->state_variables = {0.5};
+      check(throws_naming([&]() { mpm::points_at_quadrature_points(dof_handler, u, quadrature, history, materials); },
+                          "gives 1 state variable(s), the first quadrature point 2"),
+            "quadrature points with different numbers of state variables are refused");
+      for (const auto &cell : triangulation.active_cell_iterators())
+        for (unsigned int q = 0; q < quadrature.size(); ++q)
+          history.get_data(cell)[q]->state_variables.clear();
+    }
 
     // Bad input.
     {

@@ -2,8 +2,9 @@
 //  - kinematics, 2D and 3D: a displacement u = A X + b (exact in FE_Q(2)^dim) on a distorted mesh
 //    of the unit box. The points are exactly the lattice points inside the deformed box (counted
 //    independently), with F = I + A, volume (h/n)^dim and mass rho (h/n)^dim / det F to round-off;
-//  - a linear stress field is reproduced at the points by the projection of degree 2, to 1e-11 of
-//    its size (the inverse of the deformed mapping is Newton's, to about 1e-12);
+//  - a linear stress field, and two linear state variables of a user model, are reproduced at the
+//    points by the projection of degree 2, to 1e-11 of their size (the inverse of the deformed
+//    mapping is Newton's, to about 1e-12);
 //  - a smooth stress field given at the Gauss points converges at the points at the projection's
 //    rate k + 1 under refinement of the FEM mesh (k = 1 with Q1 and 2x2 Gauss, k = 2 with Q2 and
 //    3x3 Gauss, 2D; k = 1 in 3D): the observed rates between the two finest meshes must lie within
@@ -93,6 +94,8 @@ namespace
       for (int c = 0; c < mpm::n_voigt; ++c)
         s.stress[c] = sigma(x, c);
       s.plastic_strain = sigma(x, 0) * 1e-6;
+      // Two state variables of a user model (a void ratio, a hardening variable), from the same field.
+      s.state_variables = {0.6 + sigma(x, 0) * 1e-7, -sigma(x, 1) * 1e-4};
       return s;
     };
   }
@@ -153,7 +156,7 @@ namespace
 
     // The field's size: (c + 1) 1e3 (1 + x - 2 y + z) reaches 4 * 6e3 on the deformed box.
     const double linear_scale = 2.4e4;
-    double worst_F = 0, worst_volume = 0, worst_mass = 0, worst_stress = 0, worst_lattice = 0;
+    double worst_F = 0, worst_volume = 0, worst_mass = 0, worst_stress = 0, worst_lattice = 0, worst_state = 0;
     const double J = determinant(F), V = std::pow(dx, dim);
     for (int i = 0; i < p.size(); ++i)
       {
@@ -179,16 +182,22 @@ namespace
         for (int c = 0; c < mpm::n_voigt; ++c)
           if (dim == 3 || c < 4)
             worst_stress = std::max(worst_stress, std::abs(p.stress[c][i] - linear(X3, c)) / linear_scale);
+        if (p.n_state_variables() == 2)
+          worst_state = std::max({worst_state, std::abs(p.state_variables[0][i] - (0.6 + linear(X3, 0) * 1e-7)),
+                                  std::abs(p.state_variables[1][i] + linear(X3, 1) * 1e-4) / (linear_scale * 1e-4)});
+        else
+          worst_state = 1e300;
       }
     std::printf("%dD lattice hand-over of u = A X + b: %d points (%ld lattice points inside the deformed box); "
-                "F %.2e, volume %.2e, mass %.2e, stress %.2e, off-lattice %.2e\n",
-                dim, p.size(), expected, worst_F, worst_volume, worst_mass, worst_stress, worst_lattice);
+                "F %.2e, volume %.2e, mass %.2e, stress %.2e, state variables %.2e, off-lattice %.2e\n",
+                dim, p.size(), expected, worst_F, worst_volume, worst_mass, worst_stress, worst_state, worst_lattice);
     check(p.size() == expected, "the points are the lattice points inside the deformed body", p.size(), expected);
     check_below(worst_F, 1e-12, "F = I + A at every point");
     check_below(worst_volume, 1e-12, "volume (h/n)^dim");
     check_below(worst_mass, 1e-12, "mass rho (h/n)^dim / det F");
     // Round-off of the local projection and of Newton's inversion of the deformed mapping.
     check_below(worst_stress, 1e-11, "a linear stress field reproduced by the projection of degree 2");
+    check_below(worst_state, 1e-11, "two linear state variables reproduced by the same projection");
     check_below(worst_lattice, 1e-9, "positions on the lattice");
   }
 

@@ -4,8 +4,15 @@
 //    its name in the prm, gives the points of the built-in "drucker prager" to the last bit
 //    after 60 steps of the reduced 2D collapse (plastic flow from the first steps): the update,
 //    its state and the plasticity switch reach the user's code unchanged;
+//  - a model's own state variable follows its point through the whole run: the void ratio e of a
+//    model that updates 1 + e by det(I + L dt) each step equals (1 + e0) det F - 1 at every point
+//    after the full collapse (0.15 s, the points handed to the ParticleHandler and back at
+//    every re-sort into cells; on 2 ranks, 33 re-sorts and the first repartition, which moves
+//    points with their cells between ranks), to round-off; the particle table holds it under
+//    its name;
 //  - refused with a message naming the entry: Backend = cuda with a user model, a random
-//    field on a user model; a name registered twice is refused too.
+//    field on a user model, a state variable name with a space; a name registered twice is
+//    refused too.
 #include "../core/check.h"
 
 #include <mpm/core/material/drucker_prager.h>
@@ -16,6 +23,7 @@
 
 #include <deal.II/base/mpi.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
@@ -52,14 +60,55 @@ namespace
     LinearElasticParameters<double> elastic{};
     DruckerPragerParameters<double> model{};
   };
+  // The same with a state variable: the void ratio e, 1 + e = (1 + e0) V / V0, updated each step
+  // by the volume ratio det(I + L dt) of the step (L dt = d_eps + d_spin), as F is.
+  class DruckerPragerWithVoidRatio : public WrappedDruckerPrager
+  {
+  public:
+    static void declare_parameters(dealii::ParameterHandler &prm)
+    {
+      WrappedDruckerPrager::declare_parameters(prm);
+      prm.declare_entry("Initial void ratio", "0.6", dealii::Patterns::Double(0), "e0 (> 0).");
+    }
+    void parse_parameters(dealii::ParameterHandler &prm)
+    {
+      WrappedDruckerPrager::parse_parameters(prm);
+      e0 = prm.get_double("Initial void ratio");
+    }
+    std::vector<StateVariable> state_variables() const override { return {{"void_ratio", e0}}; }
+    void update_stress(const SymTensor<double> &d_eps, const Mat3<double> &d_spin, const bool plastic,
+                       SymTensor<double> &stress, double &plastic_strain, double *state) const override
+    {
+      WrappedDruckerPrager::update_stress(d_eps, d_spin, plastic, stress, plastic_strain, nullptr);
+      Mat3<double> step = Mat3<double>::identity();
+      const int    voigt[3][3] = {{0, 3, 5}, {3, 1, 4}, {5, 4, 2}};
+      for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b)
+          step.a[a][b] += d_eps[voigt[a][b]] + d_spin.a[a][b];
+      state[0] = (1 + state[0]) * determinant(step) - 1;
+    }
+
+  private:
+    double e0 = 0;
+  };
+
+  // A model whose state variable name cannot name an output field.
+  class BadStateName : public WrappedDruckerPrager
+  {
+  public:
+    std::vector<StateVariable> state_variables() const override { return {{"void ratio", 0.5}}; }
+  };
 } // namespace
 
 MPM_REGISTER_CONSTITUTIVE_MODEL(WrappedDruckerPrager, "wrapped drucker prager",
                                 "The core's Drucker-Prager behind the user-model interface (a test).");
+MPM_REGISTER_CONSTITUTIVE_MODEL(DruckerPragerWithVoidRatio, "drucker prager with void ratio",
+                                "The test's Drucker-Prager with a void ratio state variable.");
+MPM_REGISTER_CONSTITUTIVE_MODEL(BadStateName, "bad state name", "A state variable named with a space (a test).");
 
 namespace
 {
-  std::string scene_text(const std::string &model, const std::string &extra = "")
+  std::string scene_text(const std::string &model, const std::string &extra = "", const int max_steps = 60)
   {
     std::ifstream     in(std::string(MPM_SOURCE_DIR) + "/tests/prm/collapse_small_2d.prm");
     std::stringstream s;
@@ -71,7 +120,7 @@ namespace
         to.replace(to.find("drucker prager"), 14, model);
         text.replace(text.find(from), from.size(), to);
       }
-    return text + "\nsubsection Solver\n set Maximum number of steps = 60\nend\n"
+    return text + "\nsubsection Solver\n set Maximum number of steps = " + std::to_string(max_steps) + "\nend\n"
                   "subsection Output\n set Output interval = 0\n set Write particles = false\n"
                   " set Write grid fields = false\nend\n" +
            extra;
@@ -84,6 +133,62 @@ namespace
     return simulator.points();
   }
 
+  // The full collapse with the void ratio model: every point's e against its det F, in the run's
+  // arrays and in the last particle table. Returns the largest |e - ((1 + e0) det F - 1)|.
+  double void_ratio_follows_points(double &largest_volume_change)
+  {
+    const std::string directory = "output-user-model-state";
+    const std::string text =
+      scene_text("drucker prager with void ratio",
+                 "subsection Material aluminium bars\n subsection drucker prager with void ratio\n"
+                 "  set Initial void ratio = 0.65\n end\nend\n"
+                 "subsection Output\n set Directory = " + directory + "\n set Output interval = 0.05\n"
+                 " set Write particle table = true\nend\n",
+                 100000);
+    Simulator<2> simulator(parameters_from_string(text), MPI_COMM_WORLD);
+    simulator.run();
+    const HostPoints<2, double> p = simulator.points();
+    double worst = p.n_state_variables() == 1 && p.size() > 0 ? 0 : 1e300;
+    largest_volume_change = 0;
+    for (int i = 0; worst < 1e300 && i < p.size(); ++i)
+      {
+        const double J = p.deformation_gradient[0][i] * p.deformation_gradient[3][i] -
+                         p.deformation_gradient[1][i] * p.deformation_gradient[2][i];
+        worst = std::max(worst, std::abs(p.state_variables[0][i] - (1.65 * J - 1)));
+        largest_volume_change = std::max(largest_volume_change, std::abs(J - 1));
+      }
+
+    // The last particle table of this rank: the void_ratio column against the F columns.
+    const unsigned int rank = dealii::Utilities::MPI::this_mpi_process(MPI_COMM_WORLD);
+    std::ifstream      table(directory + "/particle_table_00003." + std::to_string(rank) + ".csv");
+    std::string        line;
+    std::getline(table, line);
+    std::vector<std::string> columns;
+    std::stringstream        header(line);
+    for (std::string name; std::getline(header, name, ',');)
+      columns.push_back(name);
+    auto column = [&](const std::string &name) {
+      const auto at = std::find(columns.begin(), columns.end(), name);
+      return at == columns.end() ? -1 : static_cast<int>(at - columns.begin());
+    };
+    const int e = column("void_ratio"), xx = column("F_xx"), xy = column("F_xy"), yx = column("F_yx"),
+              yy = column("F_yy");
+    int rows = 0;
+    if (e < 0 || xx < 0 || xy < 0 || yx < 0 || yy < 0)
+      worst = 1e300;
+    while (worst < 1e300 && std::getline(table, line))
+      {
+        std::vector<double> v;
+        std::stringstream   row(line);
+        for (std::string value; std::getline(row, value, ',');)
+          v.push_back(std::stod(value));
+        worst = std::max(worst, std::abs(v[e] - (1.65 * (v[xx] * v[yy] - v[xy] * v[yx]) - 1)));
+        ++rows;
+      }
+    if (rows != p.size())
+      worst = 1e300;
+    return worst;
+  }
 } // namespace
 
 int main(int argc, char **argv)
@@ -108,6 +213,17 @@ int main(int argc, char **argv)
                   worst, plastic);
       check(plastic > 1e-4, "the scene flows plastically in its first 60 steps", plastic, 1e-4);
       check(worst == 0, "the user model's run equals the built-in model's to the last bit");
+
+      double       volume_change = 0;
+      const double void_ratio    = void_ratio_follows_points(volume_change);
+      std::printf("void ratio after the collapse (0.15 s): largest |e - ((1 + e0) det F - 1)| %.3e over the points "
+                  "and the particle table; largest |det F - 1| %.3e\n",
+                  void_ratio, volume_change);
+      check(volume_change > 1e-3, "the points change volume in the collapse", volume_change, 1e-3);
+      check(void_ratio < 1e-12, "the void ratio state variable follows its point through the run and the output",
+            void_ratio, 1e-12);
+      check(throws_naming([]() { parameters_from_string(scene_text("bad state name")); }, "Material aluminium bars/Model"),
+            "a state variable name with a space is refused, naming the entry");
 
       check(throws_naming([]() { parameters_from_string(scene_text("wrapped drucker prager",
                                                                     "subsection Backend\n set Backend = cuda\nend\n")); },
