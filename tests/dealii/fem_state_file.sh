@@ -32,8 +32,9 @@ for dim in 2 3; do
     done
   done
 done
-# Bad input: a file that is not an FEM state, a material_id without an MPM material. (set -e
-# does not act on "! cmd" or on the left of "&&": each check fails the test explicitly.)
+# Bad input: a file that is not an FEM state, a material_id without an MPM material, a 3D state
+# in a 2D scene. (set -e does not act on "! cmd" or on the left of "&&": each check fails the
+# test explicitly.)
 refused() { # refused PRM TEXT...: non-zero exit, and the message holds every TEXT
   local prm=$1; shift
   if "$exe" "$prm" > "$prm.log" 2>&1; then echo "FAILED: $prm was accepted"; exit 1; fi
@@ -47,4 +48,6 @@ refused broken.prm "Initial state/FEM file" "is not an FEM state"
 sed 's|set Materials = 0: soil, 1800|set Materials = 3: soil, 1800|; s|../state.fem-state|state.fem-state|' \
   "$src/tests/dealii/fem_state_file_a.prm" > unnamed.prm
 refused unnamed.prm "Initial state/Materials" "material_id 0"
+sed 's|../state.fem-state|state-3d.fem-state|' "$src/tests/dealii/fem_state_file_a.prm" > other_dimension.prm
+refused other_dimension.prm "Initial state/FEM file" "holds a 3D state, the scene is 2D"
 echo "FEM file route: API and executable agree in both placements, 2D and 3D, on 1 and 2 ranks; bad files refused"
