@@ -99,15 +99,17 @@ namespace mpm
 
   // Return mapping of a trial stress (in: trial, out: admissible stress).
   // multiplier[0]: shear multiplier (of g_s), multiplier[1]: tension multiplier (of g_t).
+  // Also evaluated with Real = Dual (consistent_tangent.h).
   template <typename Real>
   MPM_HOST_DEVICE inline ReturnResult<Real> drucker_prager_return(const LinearElasticParameters<Real>   &elastic,
                                                                   const DruckerPragerCoefficients<Real> &k,
                                                                   SymTensor<Real>                       &stress)
   {
+    using std::sqrt; // and mpm::sqrt of a Dual (consistent_tangent.h)
     const Real K   = elastic.bulk_modulus();
     const Real G   = elastic.shear_modulus();
     const Real p   = mean_stress(stress);
-    const Real tau = std::sqrt(second_deviatoric_invariant(stress));
+    const Real tau = sqrt(second_deviatoric_invariant(stress));
     const Real f_s = tau + k.q_phi * p - k.k_phi;
     const Real x   = p - k.sigma_t; // f_t
     const Real y   = tau - k.tau_P;
@@ -163,7 +165,7 @@ namespace mpm
     r.multiplier[1] = mu_t;
     // d_eps^p = mu_s (s/(2 tau) + q_psi/3 I) + mu_t/3 I: deviatoric norm^2 mu_s^2/2, volumetric v^2/3.
     const Real v       = mu_s * k.q_psi + mu_t;
-    r.d_plastic_strain = std::sqrt(mu_s * mu_s / Real(3) + Real(2) * v * v / Real(9));
+    r.d_plastic_strain = sqrt(mu_s * mu_s / Real(3) + Real(2) * v * v / Real(9));
     return r;
   }
 

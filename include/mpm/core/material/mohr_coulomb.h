@@ -56,6 +56,7 @@ namespace mpm
   }
 
   // Return mapping on sorted principal trial stresses (in: trial, out: returned, sorted).
+  // Also evaluated with Real = Dual (consistent_tangent.h).
   // multiplier: plane (dl, 0); edges (dl_1, dl_2) of f_1 and of the neighbouring plane;
   // apex (volumetric plastic strain, 0).
   template <typename Real>
@@ -64,6 +65,8 @@ namespace mpm
                                                                           Real sigma[3])
   {
     using namespace mohr_coulomb_detail;
+    using std::abs; // and mpm::abs, mpm::sqrt of a Dual (consistent_tangent.h)
+    using std::sqrt;
     const Real f1 = mohr_coulomb_yield(s, sigma);
     if (f1 <= Real(0))
       return elastic_return<Real>();
@@ -72,7 +75,7 @@ namespace mpm
     const Real lambda = K - Real(2) / Real(3) * G;
     const Real sf = s.sin_phi, sp = s.sin_psi;
     const Real strength = Real(2) * s.cohesion * s.cos_phi;
-    const Real scale = std::abs(sigma[0]) + std::abs(sigma[1]) + std::abs(sigma[2]) + s.cohesion;
+    const Real scale = abs(sigma[0]) + abs(sigma[1]) + abs(sigma[2]) + s.cohesion;
     const Real tol   = Real(sizeof(Real) == 4 ? 1e-5 : 1e-13) * scale;
 
     const Real a1[3] = {Real(1) + sf, Real(0), -(Real(1) - sf)};
@@ -95,7 +98,7 @@ namespace mpm
           r.multiplier[0] = dl;
           r.multiplier[1] = Real(0);
           Real e[3]       = {dl * b1[0], dl * b1[1], dl * b1[2]};
-          r.d_plastic_strain = std::sqrt(Real(2) / Real(3) * dot3(e, e));
+          r.d_plastic_strain = sqrt(Real(2) / Real(3) * dot3(e, e));
           return r;
         }
       // 2. edges: the one on the side the plane return overshot first.
@@ -135,7 +138,7 @@ namespace mpm
               Real e[3];
               for (int i = 0; i < 3; ++i)
                 e[i] = dl1 * b1[i] + dl2 * b2[i];
-              r.d_plastic_strain = std::sqrt(Real(2) / Real(3) * dot3(e, e));
+              r.d_plastic_strain = sqrt(Real(2) / Real(3) * dot3(e, e));
               return r;
             }
           if (!(sf > Real(0)) && attempt == 1) // no apex without friction: keep the edge result
@@ -148,7 +151,7 @@ namespace mpm
               Real e[3];
               for (int i = 0; i < 3; ++i)
                 e[i] = dl1 * b1[i] + dl2 * b2[i];
-              r.d_plastic_strain = std::sqrt(Real(2) / Real(3) * dot3(e, e));
+              r.d_plastic_strain = sqrt(Real(2) / Real(3) * dot3(e, e));
               return r;
             }
         }
@@ -166,7 +169,7 @@ namespace mpm
     r.mode             = ReturnMode::apex;
     r.multiplier[0]    = e[0] + e[1] + e[2];
     r.multiplier[1]    = Real(0);
-    r.d_plastic_strain = std::sqrt(Real(2) / Real(3) * dot3(e, e));
+    r.d_plastic_strain = sqrt(Real(2) / Real(3) * dot3(e, e));
     return r;
   }
 
