@@ -6,18 +6,23 @@
 //  - Mohr-Coulomb: plane, compression edge, extension edge, apex, and a trial stress with two
 //    equal principal stresses (the rotation term's limit), on principal axes rotated off the
 //    coordinate axes;
-//  - the stress the tangent functions return equals the plain return mapping's to the last bit.
+//  - the stress the tangent functions return equals the plain return mapping's to the last bit;
+//  - small_strain_update (the FEM stage's point update) gives the MPM's update_stress with no
+//    spin to the last bit, stress and plastic strain, over 3,000 random states and increments of
+//    elastic, Drucker-Prager and Mohr-Coulomb materials with softening, plasticity on and off.
 // Tolerance: 1e-6 of the largest elastic stiffness entry. The differences use a strain step of 1e-9 around
 // increments that keep every perturbed state in the same region; their error is about
 // 1e-16 |sigma| / 1e-9 ~ 1e-2 Pa against entries of ~1e7 Pa (1e-9 relative), and a region
 // boundary crossed inside the stencil would show as an O(1) error.
 #include <mpm/core/material/consistent_tangent.h>
+#include <mpm/core/material/small_strain_update.h>
 
 #include "check.h"
 
 #include <algorithm>
 #include <cstdio>
 #include <functional>
+#include <random>
 #include <string>
 
 using namespace mpm;
@@ -171,6 +176,57 @@ namespace
         report(c.name, tangent_error(c.trial, C, update), r.mode == c.mode, same);
       }
   }
+  void small_strain_update_is_the_mpm_update()
+  {
+    SofteningStrength<double> strength;
+    strength.cohesion                = 2e4;
+    strength.residual_cohesion       = 5e3;
+    strength.softening_modulus       = 1e6;
+    strength.friction_angle          = 30 * deg;
+    strength.residual_friction_angle = 25 * deg;
+    strength.dilatancy_angle         = 10 * deg;
+    MaterialParameters<double> materials[3] = {};
+    for (auto &m : materials)
+      m.elastic = elastic;
+    materials[0].model                          = MaterialModel::linear_elastic;
+    materials[1].model                          = MaterialModel::drucker_prager;
+    materials[1].drucker_prager.strength        = strength;
+    materials[1].drucker_prager.tensile_strength = 5e3;
+    materials[2].model                          = MaterialModel::mohr_coulomb;
+    materials[2].mohr_coulomb.strength          = strength;
+
+    std::mt19937                           random(7);
+    std::uniform_real_distribution<double> stress_value(-2e5, 3e4), strain_value(-4e-3, 4e-3), eps_p(0, 0.02);
+    int                                    differ = 0, plastic = 0, n = 0;
+    for (int trial = 0; trial < 1000; ++trial)
+      for (MaterialParameters<double> m : materials)
+        {
+          m.plasticity_enabled = trial % 4 != 0;
+          SymTensor<double> sigma, d_eps;
+          for (int c = 0; c < n_voigt; ++c)
+            {
+              sigma[c] = stress_value(random) * (c < 3 ? 1.0 : 0.3);
+              d_eps[c] = strain_value(random);
+            }
+          const double             e0 = eps_p(random);
+          MaterialPointState<double> mpm{sigma, e0};
+          update_stress(m, d_eps, Mat3<double>{}, mpm);
+          SymTensor<double> fem = sigma;
+          double            e   = e0;
+          Tangent           C;
+          const ReturnResult<double> r = small_strain_update(m, d_eps, fem, e, C);
+          plastic += r.mode != ReturnMode::elastic;
+          bool same = e == mpm.plastic_strain;
+          for (int c = 0; c < n_voigt; ++c)
+            same = same && fem[c] == mpm.stress[c];
+          differ += !same;
+          ++n;
+        }
+    std::printf("small_strain_update against update_stress with no spin: %d of %d states differ, %d plastic\n",
+                differ, n, plastic);
+    check(differ == 0, "small_strain_update gives the MPM's update to the last bit");
+    check(plastic > n / 4, "a good share of the states return plastically", plastic, n / 4);
+  }
 } // namespace
 
 int main()
@@ -183,5 +239,6 @@ int main()
         "elastic tangent: C_xxyy = lambda");
   drucker_prager_cases();
   mohr_coulomb_cases();
+  small_strain_update_is_the_mpm_update();
   return mpm_test::finish("test_consistent_tangent");
 }

@@ -1,0 +1,37 @@
+// One quadrature point of the implicit small-strain FEM stage (issue 14): the built-in model's
+// update over a strain increment, with its consistent tangent. The same physics as the MPM's
+// update_stress (material.h) with no spin (small strain has no rotation to follow): elastic
+// trial, the model's return mapping, explicit softening (strength at the start of the
+// increment), the plasticity switch. Host only (the FEM stage runs on the CPU).
+#pragma once
+
+#include <mpm/core/material/consistent_tangent.h>
+#include <mpm/core/material/material.h>
+
+namespace mpm
+{
+  // stress, plastic_strain: the state at the start of the increment, updated in place;
+  // C: d stress / d d_eps (consistent_tangent.h's convention). A user model has no tangent here
+  // and is refused by the FEM stage before it gets this far; given one, C is left elastic.
+  inline ReturnResult<double> small_strain_update(const MaterialParameters<double> &m, const SymTensor<double> &d_eps,
+                                                  SymTensor<double> &stress, double &plastic_strain, Tangent C)
+  {
+    const SymTensor<double> d_sigma = elastic_stress_increment(m.elastic, d_eps);
+    for (int c = 0; c < n_voigt; ++c)
+      stress[c] += d_sigma[c];
+    ReturnResult<double> r = elastic_return<double>();
+    if (m.plasticity_enabled && m.model == MaterialModel::drucker_prager)
+      {
+        const DruckerPragerCoefficients<double> k =
+          drucker_prager_coefficients(current_strength(m.drucker_prager.strength, plastic_strain),
+                                      m.drucker_prager.tensile_strength);
+        r = drucker_prager_tangent(m.elastic, k, stress, C);
+      }
+    else if (m.plasticity_enabled && m.model == MaterialModel::mohr_coulomb)
+      r = mohr_coulomb_tangent(m.elastic, current_strength(m.mohr_coulomb.strength, plastic_strain), stress, C);
+    else
+      elastic_tangent(m.elastic, C);
+    plastic_strain += r.d_plastic_strain;
+    return r;
+  }
+} // namespace mpm
