@@ -9,7 +9,8 @@
 //  - the stress the tangent functions return equals the plain return mapping's to the last bit;
 //  - small_strain_update (the FEM stage's point update) gives the MPM's update_stress with no
 //    spin to the last bit, stress and plastic strain, over 3,000 random states and increments of
-//    elastic, Drucker-Prager and Mohr-Coulomb materials with softening, plasticity on and off.
+//    elastic, Drucker-Prager and Mohr-Coulomb materials with softening, plasticity on and off;
+//    a user model is refused (it gives no tangent).
 // Tolerance: 1e-6 of the largest elastic stiffness entry. The differences use a strain step of 1e-9 around
 // increments that keep every perturbed state in the same region; their error is about
 // 1e-16 |sigma| / 1e-9 ~ 1e-2 Pa against entries of ~1e7 Pa (1e-9 relative), and a region
@@ -101,6 +102,31 @@ namespace
     check_below(error, 1e-6, (what + ": tangent matches finite differences").c_str());
   }
 
+  struct Case
+  {
+    const char       *name;
+    SymTensor<double> trial;
+    ReturnMode        mode;
+  };
+
+  // Each case: the region it lands in, the stress against the plain update, the tangent against
+  // finite differences. tangent(stress, C) returns the trial stress and fills C.
+  template <std::size_t n, typename TangentFunction>
+  void check_cases(const Case (&cases)[n], const Update &update, TangentFunction &&tangent)
+  {
+    for (const Case &c : cases)
+      {
+        SymTensor<double>          s = c.trial;
+        Tangent                    C;
+        const ReturnResult<double> r     = tangent(s, C);
+        const SymTensor<double>    plain = update(c.trial);
+        bool                       same  = true;
+        for (int i = 0; i < n_voigt; ++i)
+          same = same && s[i] == plain[i];
+        report(c.name, tangent_error(c.trial, C, update), r.mode == c.mode, same);
+      }
+  }
+
   void drucker_prager_cases()
   {
     SofteningStrength<double> strength;
@@ -113,29 +139,15 @@ namespace
       drucker_prager_return(elastic, k, s);
       return s;
     };
-    struct Case
-    {
-      const char       *name;
-      SymTensor<double> trial;
-      ReturnMode        mode;
-    };
     const Case cases[] = {
       {"Drucker-Prager, elastic", rotated(-2e4, -3e4, -4e4), ReturnMode::elastic},
       {"Drucker-Prager, cone", rotated(-1e4, -6e4, -1.6e5), ReturnMode::shear},
       {"Drucker-Prager, tension cut-off", rotated(1.2e4, 1.0e4, 0.9e4), ReturnMode::tension},
       {"Drucker-Prager, corner (cone and cut-off)", rotated(6e4, 1e4, -1e4), ReturnMode::corner},
     };
-    for (const Case &c : cases)
-      {
-        SymTensor<double> s = c.trial;
-        Tangent           C;
-        const ReturnResult<double> r = drucker_prager_tangent(elastic, k, s, C);
-        const SymTensor<double>    plain = update(c.trial);
-        bool                       same  = true;
-        for (int i = 0; i < n_voigt; ++i)
-          same = same && s[i] == plain[i];
-        report(c.name, tangent_error(c.trial, C, update), r.mode == c.mode, same);
-      }
+    check_cases(cases, update, [&](SymTensor<double> &stress, Tangent C) {
+      return drucker_prager_tangent(elastic, k, stress, C);
+    });
   }
 
   void mohr_coulomb_cases()
@@ -150,12 +162,6 @@ namespace
       mohr_coulomb_return(elastic, current, s);
       return s;
     };
-    struct Case
-    {
-      const char       *name;
-      SymTensor<double> trial;
-      ReturnMode        mode;
-    };
     const Case cases[] = {
       {"Mohr-Coulomb, elastic", rotated(-2e4, -3e4, -4e4), ReturnMode::elastic},
       {"Mohr-Coulomb, plane", rotated(-1e4, -6e4, -1.6e5), ReturnMode::shear},
@@ -164,18 +170,11 @@ namespace
       {"Mohr-Coulomb, extension edge, sigma_2 = sigma_3", rotated(-1e4, -1.5e5, -1.5e5), ReturnMode::edge_extension},
       {"Mohr-Coulomb, apex", rotated(6e4, 5e4, 4e4), ReturnMode::apex},
     };
-    for (const Case &c : cases)
-      {
-        SymTensor<double> s = c.trial;
-        Tangent           C;
-        const ReturnResult<double> r = mohr_coulomb_tangent(elastic, current, s, C);
-        const SymTensor<double>    plain = update(c.trial);
-        bool                       same  = true;
-        for (int i = 0; i < n_voigt; ++i)
-          same = same && s[i] == plain[i];
-        report(c.name, tangent_error(c.trial, C, update), r.mode == c.mode, same);
-      }
+    check_cases(cases, update, [&](SymTensor<double> &stress, Tangent C) {
+      return mohr_coulomb_tangent(elastic, current, stress, C);
+    });
   }
+
   void small_strain_update_is_the_mpm_update()
   {
     SofteningStrength<double> strength;
@@ -226,6 +225,22 @@ namespace
                 differ, n, plastic);
     check(differ == 0, "small_strain_update gives the MPM's update to the last bit");
     check(plastic > n / 4, "a good share of the states return plastically", plastic, n / 4);
+
+    MaterialParameters<double> user = materials[0];
+    user.model                      = MaterialModel::user_defined;
+    SymTensor<double> sigma         = SymTensor<double>::zero(), d_eps = SymTensor<double>::zero();
+    double            e             = 0;
+    Tangent           C;
+    bool              refused = false;
+    try
+      {
+        small_strain_update(user, d_eps, sigma, e, C);
+      }
+    catch (const std::invalid_argument &)
+      {
+        refused = true;
+      }
+    check(refused, "small_strain_update refuses a user model (no tangent)");
   }
 } // namespace
 

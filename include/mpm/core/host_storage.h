@@ -5,6 +5,7 @@
 #include <mpm/core/views.h>
 
 #include <cstdint>
+#include <stdexcept>
 #include <type_traits>
 #include <utility>
 #include <vector>
@@ -84,8 +85,13 @@ namespace mpm
     f(a.material_field, b.material_field);
     f(a.material, b.material);
     if constexpr (has_state_variables<std::decay_t<A>>::value && has_state_variables<std::decay_t<B>>::value)
-      for (std::size_t k = 0; k < a.state_variables.size(); ++k)
-        f(a.state_variables[k], b.state_variables[k]);
+      {
+        if (b.state_variables.size() < a.state_variables.size())
+          throw std::length_error("for_each_point_array: the second owner holds fewer state variables than the "
+                                  "first (HostPoints::set_n_state_variables).");
+        for (std::size_t k = 0; k < a.state_variables.size(); ++k)
+          f(a.state_variables[k], b.state_variables[k]);
+      }
   }
 
   template <int dim, typename Real>

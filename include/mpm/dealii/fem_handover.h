@@ -93,16 +93,17 @@ namespace mpm
                                        "initialised with the locally relevant DoFs) on several MPI ranks."));
     }
 
-    // The state variables of one quadrature point into point i; the first point fixes their
-    // number, every other must give as many.
-    template <int dim>
+    // The state variables of quadrature point q of `cell` into point i; the first point fixes
+    // their number, every other must give as many.
+    template <int dim, typename Cell>
     void set_state_variables(HostPoints<dim, double> &p, const int i, const std::vector<double> &values,
-                             const std::string &where)
+                             const Cell &cell, const unsigned int q)
     {
       if (i == 0)
         p.set_n_state_variables(static_cast<int>(values.size()));
       AssertThrow(static_cast<int>(values.size()) == p.n_state_variables(),
-                  dealii::ExcMessage("FEM hand-over: " + where + " gives " + std::to_string(values.size()) +
+                  dealii::ExcMessage("FEM hand-over: quadrature point " + std::to_string(q) + " of cell " +
+                                     cell->id().to_string() + " gives " + std::to_string(values.size()) +
                                      " state variable(s), the first quadrature point " +
                                      std::to_string(p.n_state_variables()) + "."));
       for (int k = 0; k < p.n_state_variables(); ++k)
@@ -207,8 +208,7 @@ namespace mpm
             if (dim == 2)
               p.stress[4][i] = p.stress[5][i] = 0; // plane strain: no out-of-plane shear
             p.plastic_strain[i] = s.plastic_strain;
-            internal::set_state_variables(p, i, s.state_variables,
-                                          "quadrature point " + std::to_string(q) + " of cell " + cell->id().to_string());
+            internal::set_state_variables(p, i, s.state_variables, cell, q);
             p.initial_volume[i] = V0;
             p.volume[i]         = J * V0;
             p.mass[i]           = material.density * V0;

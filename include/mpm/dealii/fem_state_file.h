@@ -14,7 +14,7 @@
 //
 // The file holds the active cells of the mesh (their vertices and material_id), the name of the
 // finite element, the displacement's values on each cell, the quadrature rule and the state of
-// every quadrature point, written with boost::serialization (deal.II's serialization) by rank 0
+// every quadrature point (stress, plastic strain, state variables), written with boost::serialization (deal.II's serialization) by rank 0
 // after a gather, atomically (written beside, then renamed). The executable rebuilds the mesh
 // as a parallel::distributed::Triangulation whose coarse cells are the saved cells (p4est
 // partitions them over any number of ranks), the FE with FETools::get_fe_by_name, the

@@ -11,6 +11,7 @@
 //     static void declare_parameters(dealii::ParameterHandler &prm);  // its prm entries
 //     void parse_parameters(dealii::ParameterHandler &prm);           // reads them, throws on bad ones
 //     void update_stress(...) const override;                         // user_model.h
+//     std::vector<mpm::StateVariable> state_variables() const override; // optional: its own state
 //     mpm::LinearElasticParameters<double> elastic_parameters() const override;
 //   };
 //   MPM_REGISTER_CONSTITUTIVE_MODEL(VonMises, "von mises", "J2 plasticity, perfectly plastic.");

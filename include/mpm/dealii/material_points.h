@@ -70,7 +70,8 @@ namespace mpm
     std::shared_ptr<const PointLabels<dim>> labels;
 
     // Property array of point i in the handler's layout (PropertyLayout): the values the
-    // handler would hold after a hand-over.
+    // handler would hold after a hand-over. values holds
+    // PropertyLayout<dim>::n_properties(points.n_state_variables()) entries.
     void properties(int i, double *values) const;
   };
 

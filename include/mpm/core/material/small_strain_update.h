@@ -8,14 +8,20 @@
 #include <mpm/core/material/consistent_tangent.h>
 #include <mpm/core/material/material.h>
 
+#include <stdexcept>
+
 namespace mpm
 {
   // stress, plastic_strain: the state at the start of the increment, updated in place;
-  // C: d stress / d d_eps (consistent_tangent.h's convention). A user model has no tangent here
-  // and is refused by the FEM stage before it gets this far; given one, C is left elastic.
+  // C: d stress / d d_eps (consistent_tangent.h's convention). Returns the return mapping's
+  // result (mode, multipliers, eps_p increment). A user model (user_model.h) gives no tangent:
+  // it is refused with std::invalid_argument.
   inline ReturnResult<double> small_strain_update(const MaterialParameters<double> &m, const SymTensor<double> &d_eps,
                                                   SymTensor<double> &stress, double &plastic_strain, Tangent C)
   {
+    if (m.model == MaterialModel::user_defined)
+      throw std::invalid_argument("small_strain_update: a constitutive model defined outside the library gives no "
+                                  "consistent tangent; the implicit FEM stage takes the built-in models only.");
     const SymTensor<double> d_sigma = elastic_stress_increment(m.elastic, d_eps);
     for (int c = 0; c < n_voigt; ++c)
       stress[c] += d_sigma[c];
