@@ -4,6 +4,7 @@
 //   dealii-mpm --help
 #include <mpm/dealii/parameters.h>
 #include <mpm/dealii/simulator.h>
+#include <mpm/fem/continuation.h>
 
 #include <deal.II/base/mpi.h>
 
@@ -63,7 +64,10 @@ int main(int argc, char **argv)
           return 2;
         }
       const mpm::Parameters parameters = mpm::read_parameters(first);
-      mpm::run_simulation(parameters, MPI_COMM_WORLD);
+      if (parameters.prefailure.analysis != mpm::fem::Analysis::none)
+        mpm::fem::run_prefailure_analysis(parameters, MPI_COMM_WORLD);
+      else
+        mpm::run_simulation(parameters, MPI_COMM_WORLD);
     }
   catch (const dealii::ExceptionBase &e)
     {

@@ -286,7 +286,8 @@ namespace mpm
                       "state (FE_DGQ); -1 = the FEM's displacement degree. Needs degree + 1 quadrature points per "
                       "direction.");
     prm.declare_entry("Materials", "", Patterns::Anything(),
-                      "Source = FEM file: 'id: name, density; ...' for every material_id of the FEM mesh: the MPM "
+                      "Source = FEM file, or Pre-failure analysis/Mesh = mesh file: 'id: name, density; ...' for every "
+                      "material_id of the FEM mesh: the MPM "
                       "material (one of Materials/Names) and the density in kg/m^3 (> 0), e.g. '0: soil, 2000; 1: "
                       "rock, 2400'.");
     prm.declare_entry("Equilibrate", "false", Patterns::Bool(),
@@ -307,6 +308,8 @@ namespace mpm
                       "Equilibrate: a state that is not at rest after this many damped steps stops the run "
                       "(a body that fails under its own weight never comes to rest).");
     prm.leave_subsection();
+
+    fem::PrefailureParameters::declare(prm, dim);
 
     prm.enter_subsection("Backend");
     prm.declare_entry("Backend", "cpu", Patterns::Selection("cpu|cuda"),
@@ -470,6 +473,9 @@ namespace mpm
         material_models.push_back(model);
       }
 
+    prefailure.parse(prm, dim);
+    const bool fem_mesh_file = prefailure.analysis != fem::Analysis::none && prefailure.mesh == "mesh file";
+
     prm.enter_subsection("Initial state");
     initial_state_source     = prm.get("Source");
     fem_file                 = prm.get("FEM file");
@@ -487,10 +493,13 @@ namespace mpm
     if (equilibrate && gravity_ramp_time > 0)
       fail("Initial state/Equilibrate", "the equilibration holds gravity in full; it needs Solver/Gravity ramp "
                                         "time = 0 (a ramp after it would take the load off the state).");
-    if (initial_state_source == "FEM file")
+    if (initial_state_source == "FEM file" && prefailure.analysis != fem::Analysis::none)
+      fail("Initial state/Source", "the FEM file and a Pre-failure analysis are two initial states; choose one "
+                                   "(Source = prm bodies, or Pre-failure analysis/Method = none).");
+    if (initial_state_source == "FEM file" && fem_file.empty())
+      fail("Initial state/FEM file", "Source = FEM file needs the file's name.");
+    if (initial_state_source == "FEM file" || fem_mesh_file)
       {
-        if (fem_file.empty())
-          fail("Initial state/FEM file", "Source = FEM file needs the file's name.");
         for (const std::string &item : dealii::Utilities::split_string_list(prm.get("Materials"), ';'))
           {
             const std::string where = "Initial state/Materials";
@@ -520,7 +529,9 @@ namespace mpm
             fem_materials[id] = {static_cast<unsigned int>(name - material_names.begin()), density};
           }
         if (fem_materials.empty())
-          fail("Initial state/Materials", "Source = FEM file needs at least one 'id: material name, density'.");
+          fail("Initial state/Materials", std::string(fem_mesh_file ? "Pre-failure analysis/Mesh = mesh file" :
+                                                                      "Source = FEM file") +
+                                            " needs at least one 'id: material name, density'.");
       }
     prm.leave_subsection();
 

@@ -6,6 +6,7 @@
 #include <mpm/core/material/material.h>
 #include <mpm/core/shape_functions.h>
 #include <mpm/core/step.h>
+#include <mpm/fem/prefailure_parameters.h>
 #include <mpm/fields/gaussian_random_field.h>
 
 #include <deal.II/base/parameter_handler.h>
@@ -108,6 +109,9 @@ namespace mpm
     unsigned int equilibration_maximum_steps = 100000;
     // FEM material_id -> (index into materials, density)
     std::map<unsigned int, std::pair<unsigned int, double>> fem_materials;
+
+    // The FEM stage before the MPM (subsection Pre-failure analysis; mpm/fem/)
+    fem::PrefailureParameters prefailure;
 
     // Backend
     std::string backend;
