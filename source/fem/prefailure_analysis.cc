@@ -38,6 +38,20 @@ namespace mpm::fem
     , triangulation(communicator)
   {
     fem_materials = create_mesh(parameters, triangulation);
+    if (parameters.prefailure.analysis == Analysis::strength_reduction)
+      {
+        std::string elastic;
+        bool        any_strength = false;
+        for (const auto &[id, m] : fem_materials)
+          if (m.parameters.model == MaterialModel::drucker_prager || m.parameters.model == MaterialModel::mohr_coulomb)
+            any_strength = true;
+          else
+            elastic += (elastic.empty() ? "" : ", ") + m.name;
+        AssertThrow(any_strength,
+                    ExcMessage("Parameter 'Pre-failure analysis/Method': strength reduction divides c and tan(phi), "
+                               "but no material of the mesh has them (" + elastic + ": linear elastic); give one a "
+                               "strength (Materials/Material <name>/Model = drucker prager or mohr coulomb)."));
+      }
     quasi_static  = std::make_unique<QuasiStaticSolver<dim>>(triangulation, fem_materials, parameters.prefailure,
                                                             parameters.gravity);
   }
