@@ -20,6 +20,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iostream>
 
 namespace mpm::fem
 {
@@ -163,8 +164,13 @@ namespace mpm::fem
           MPI_Allreduce(&normal_axes, &all, 1, MPI_UNSIGNED, MPI_BAND, communicator);
           normal_axes = all;
         }
-        if (n_faces == 0)
-          continue; // an id of the default list this mesh does not have (e.g. x max at a slope's toe)
+        if (n_faces == 0) // e.g. x max of the default list at a slope's toe, or a mistyped id: say so
+          {
+            if (Utilities::MPI::this_mpi_process(communicator) == 0)
+              std::cout << "  note: Pre-failure analysis/Boundary conditions names boundary id " << id
+                        << ", which no boundary face of this mesh has; ignored." << std::endl;
+            continue;
+          }
         if (condition == BoundaryCondition::fixed)
           VectorTools::interpolate_boundary_values(dofs, id, Functions::ZeroFunction<dim>(dim), constraints);
         else
