@@ -287,6 +287,19 @@ namespace mpm::fem
         fail("Materials/Material " + m.name + "/Random field",
              "the FEM stage takes uniform materials; a random field is not carried into it.");
     triangulation.copy_triangulation(coarse);
+    // Periodic pairs (checked in the parameters: ids 2d, 2d + 1 both periodic) are tied on
+    // the coarse mesh, before refinement, as p4est needs.
+    for (int d = 0; d < dim; ++d)
+      if (fem.boundary_conditions.count(2 * d) && fem.boundary_conditions.at(2 * d) == BoundaryCondition::periodic)
+        {
+          std::vector<GridTools::PeriodicFacePair<typename parallel::distributed::Triangulation<dim>::cell_iterator>> pairs;
+          GridTools::collect_periodic_faces(triangulation, 2 * d, 2 * d + 1, d, pairs);
+          if (pairs.empty())
+            fail("Pre-failure analysis/Boundary conditions",
+                 "boundary ids " + std::to_string(2 * d) + " and " + std::to_string(2 * d + 1) +
+                   " are periodic, but the mesh has no faces of those ids to pair.");
+          triangulation.add_periodicity(pairs);
+        }
     triangulation.refine_global(fem.global_refinements);
     return materials;
   }

@@ -27,6 +27,11 @@ namespace mpm::fem
         << std::scientific << std::setprecision(2) << r.residuals.back();
       if (r.line_search_halvings)
         s << ", " << r.line_search_halvings << " line-search halving(s)";
+      if (r.singular_tangent)
+        s << ", singular tangent";
+      if (r.initial_stiffness_iterations)
+        s << "; then " << r.initial_stiffness_iterations << " initial-stiffness iteration(s)";
+      s << std::defaultfloat << std::setprecision(3) << " (" << r.wall_seconds << " s)";
       return s.str();
     }
   } // namespace

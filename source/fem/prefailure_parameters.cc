@@ -96,13 +96,26 @@ namespace mpm::fem
                       Patterns::Anything(),
                       "'id: condition; ...' with condition fixed (every displacement component zero), roller "
                       "(the component normal to the boundary zero; the boundary must be a plane normal to an "
-                      "axis) or free. Ids not named are free. The default fixes the base and holds the sides by "
-                      "rollers.");
+                      "axis), periodic (ids 2d and 2d+1, the opposite faces of the body's bounding box normal to "
+                      "axis d, both named periodic: the displacement is the same on both, e.g. a long slope "
+                      "modelled by one slice) or free. Ids not named are free. The default fixes the base and "
+                      "holds the sides by rollers.");
     prm.declare_entry("Load steps", "4", Patterns::Integer(1, 10000),
                       "Gravity loading: gravity is applied in this many equal increments.");
     prm.declare_entry("Maximum Newton iterations", "50", Patterns::Integer(1, 10000),
                       "Newton iterations of one load step or one factor before it counts as not converged "
                       "(under strength reduction: the factor fails).");
+    prm.declare_entry("Maximum initial stiffness iterations", "1000", Patterns::Integer(0, 1000000),
+                      "Where Newton does not converge, the load step or factor is tried again from the last "
+                      "converged state with the initial-stiffness method (the elastic stiffness, factorised "
+                      "once; Griffiths & Lane's iteration), up to this many iterations; it is slower but does "
+                      "not cycle where non-associated plasticity makes Newton cycle. 0: Newton only.");
+    prm.declare_entry("Initial stiffness tolerance", "1e-5", Patterns::Double(0),
+                      "The initial-stiffness iterations have converged when the residual's norm is below this "
+                      "multiple of the full gravity load's norm. Their rate is linear, and slow near failure, so "
+                      "this is looser than Residual tolerance; under strength reduction the factor of safety "
+                      "found this way depends on it and on Maximum initial stiffness iterations "
+                      "(doc/prefailure.md).");
     prm.declare_entry("Residual tolerance", "1e-8", Patterns::Double(0),
                       "Newton has converged when the residual's norm is below this multiple of the norm of the "
                       "full gravity load vector (the body's weight on the nodes).");
@@ -154,6 +167,8 @@ namespace mpm::fem
     degree             = prm.get_integer("Polynomial degree");
     load_steps         = prm.get_integer("Load steps");
     maximum_newton_iterations = prm.get_integer("Maximum Newton iterations");
+    maximum_initial_stiffness_iterations = prm.get_integer("Maximum initial stiffness iterations");
+    initial_stiffness_tolerance          = prm.get_double("Initial stiffness tolerance");
     residual_tolerance = prm.get_double("Residual tolerance");
     line_search        = prm.get_bool("Line search");
     linear_solver      = prm.get("Linear solver");
@@ -168,16 +183,31 @@ namespace mpm::fem
       {
         const auto colon = item.find(':');
         if (colon == std::string::npos)
-          fail("Boundary conditions", "'" + item + "' is not of the form 'id: fixed|roller|free'.");
+          fail("Boundary conditions", "'" + item + "' is not of the form 'id: fixed|roller|periodic|free'.");
         const double      id   = number("Boundary conditions", item.substr(0, colon));
         const std::string kind = dealii::Utilities::trim(item.substr(colon + 1));
         if (!(id >= 0 && id <= 254 && id == std::floor(id)) || boundary_conditions.count(static_cast<unsigned>(id)))
           fail("Boundary conditions", "'" + item + "': the id must be a boundary id 0..254, named once.");
-        if (kind != "fixed" && kind != "roller" && kind != "free")
-          fail("Boundary conditions", "'" + item + "': the condition must be one of fixed, roller, free.");
+        if (kind != "fixed" && kind != "roller" && kind != "periodic" && kind != "free")
+          fail("Boundary conditions", "'" + item + "': the condition must be one of fixed, roller, periodic, free.");
         boundary_conditions[static_cast<unsigned int>(id)] =
-          kind == "fixed" ? BoundaryCondition::fixed : (kind == "roller" ? BoundaryCondition::roller : BoundaryCondition::free);
+          kind == "fixed"    ? BoundaryCondition::fixed :
+          kind == "roller"   ? BoundaryCondition::roller :
+          kind == "periodic" ? BoundaryCondition::periodic :
+                               BoundaryCondition::free;
       }
+    for (const auto &[id, kind] : boundary_conditions)
+      if (kind == BoundaryCondition::periodic)
+        {
+          const unsigned int partner = id ^ 1u;
+          if (id >= 2 * dim || !boundary_conditions.count(partner) ||
+              boundary_conditions.at(partner) != BoundaryCondition::periodic)
+            fail("Boundary conditions", "boundary id " + std::to_string(id) +
+                                          " is periodic; periodic ids come in the pairs of the bounding box's faces "
+                                          "(0 and 1: x; 2 and 3: the second axis" +
+                                          (dim == 3 ? std::string("; 4 and 5: z") : std::string()) +
+                                          "), both named periodic.");
+        }
 
     monitor_point.clear();
     const std::string monitor = dealii::Utilities::trim(prm.get("Monitor point"));
@@ -220,5 +250,8 @@ namespace mpm::fem
       }
     if (!(residual_tolerance > 0))
       fail("Residual tolerance", "must be > 0.");
+    if (maximum_initial_stiffness_iterations > 0 && !(initial_stiffness_tolerance >= residual_tolerance))
+      fail("Initial stiffness tolerance", "must be at least Residual tolerance (" + std::to_string(residual_tolerance) +
+                                            "): it is the looser test of the slower fallback.");
   }
 } // namespace mpm::fem

@@ -115,6 +115,7 @@ namespace mpm::fem
     DoFTools::make_sparsity_pattern(dofs, dsp, constraints, false);
     SparsityTools::distribute_sparsity_pattern(dsp, owned, communicator, relevant);
     tangent.reinit(owned, owned, dsp, communicator);
+    elastic_stiffness.reinit(owned, owned, dsp, communicator);
     residual.reinit(owned, communicator);
     solution.reinit(owned, relevant, communicator);
     committed.reinit(owned, relevant, communicator);
@@ -139,11 +140,16 @@ namespace mpm::fem
     constraints.clear();
     constraints.reinit(relevant);
     DoFTools::make_hanging_node_constraints(dofs, constraints);
+    // Periodic pairs before the Dirichlet values: a node both periodic and on a fixed boundary
+    // is tied to its partner, which carries the fixed value.
+    for (const auto &[id, condition] : parameters.boundary_conditions)
+      if (condition == BoundaryCondition::periodic && id % 2 == 0)
+        DoFTools::make_periodicity_constraints(dofs, id, id + 1, id / 2, constraints);
     // Which axes each roller boundary is a plane normal to: every face of the id spans zero
     // along the axis (bit d set), over every rank.
     for (const auto &[id, condition] : parameters.boundary_conditions)
       {
-        if (condition == BoundaryCondition::free)
+        if (condition == BoundaryCondition::free || condition == BoundaryCondition::periodic)
           continue;
         unsigned int normal_axes = (1u << dim) - 1, n_faces = 0;
         for (const auto &cell : dofs.active_cell_iterators())
@@ -196,7 +202,7 @@ namespace mpm::fem
                                           const double strength_factor, const Matrix matrix)
   {
     const bool                      with_matrix = matrix != Matrix::none;
-    TrilinosWrappers::SparseMatrix &A           = tangent;
+    TrilinosWrappers::SparseMatrix &A           = matrix == Matrix::elastic ? elastic_stiffness : tangent;
     using V = VoigtComponents<dim>;
     std::map<types::material_id, MaterialParameters<double>> reduced;
     for (const auto &[id, m] : materials)
@@ -223,6 +229,9 @@ namespace mpm::fem
           const MaterialParameters<double> &m       = reduced.at(cell->material_id());
           const double                      density = materials.at(cell->material_id()).density;
           const auto                        points  = histories.get_data(cell);
+          Tangent                           elastic_C;
+          if (matrix == Matrix::elastic)
+            elastic_tangent(m.elastic, elastic_C);
           cell_matrix                               = 0;
           cell_rhs                                  = 0;
           for (unsigned int q = 0; q < n_q; ++q)
@@ -230,6 +239,7 @@ namespace mpm::fem
               double eps[n_voigt];
               to_voigt(strains[q], eps);
               const UpdatedPoint p = update_point(m, *points[q], eps);
+              const auto        &C = matrix == Matrix::elastic ? elastic_C : p.C;
 
               const double       JxW = fe_values.JxW(q);
               for (unsigned int i = 0; i < n; ++i)
@@ -250,7 +260,7 @@ namespace mpm::fem
                       {
                         double s = 0;
                         for (int b = 0; b < V::n; ++b)
-                          s += p.C[V::index[a]][V::index[b]] * B[j][b];
+                          s += C[V::index[a]][V::index[b]] * B[j][b];
                         CB[j][a] = V::weight[a] * s * JxW;
                       }
                   for (unsigned int i = 0; i < n; ++i)
@@ -311,8 +321,17 @@ namespace mpm::fem
     u        = committed;
     solution = committed;
     double r = assemble(solution, load_factor, strength_factor, Matrix::tangent);
+    // Newton's iterate of least residual: where Newton cycles, the initial-stiffness
+    // iterations start from there.
+    TrilinosWrappers::MPI::Vector best(u);
+    double                        r_best = r;
     for (;;)
       {
+        if (r < r_best)
+          {
+            r_best = r;
+            best   = u;
+          }
         report.residuals.push_back(r / load_norm);
         if (!std::isfinite(r))
           break;
@@ -324,7 +343,15 @@ namespace mpm::fem
         if (report.iterations == settings.maximum_newton_iterations)
           break;
         update = 0;
-        solve_linear(tangent, update);
+        try
+          {
+            solve_linear(tangent, update);
+          }
+        catch (const ExceptionBase &) // a singular tangent (a mechanism): Newton cannot go on
+          {
+            report.singular_tangent = true;
+            break;
+          }
         ++report.iterations;
         // Backtracking: halve the step until the residual falls (at most 6 times; the last
         // step is taken in any case).
@@ -343,6 +370,8 @@ namespace mpm::fem
         u = trial;
         r = r_trial;
       }
+    if (!report.converged && std::isfinite(r) && settings.maximum_initial_stiffness_iterations > 0)
+      report.converged = solve_initial_stiffness(best, load_factor, strength_factor, report);
     if (report.converged)
       {
         commit(strength_factor);
@@ -352,6 +381,44 @@ namespace mpm::fem
       solution = committed;
     report.wall_seconds = timer.wall_time();
     return report;
+  }
+
+  template <int dim>
+  bool QuasiStaticSolver<dim>::solve_initial_stiffness(const TrilinosWrappers::MPI::Vector &start,
+                                                       const double load_factor, const double strength_factor,
+                                                       NewtonReport &report)
+  {
+    TrilinosWrappers::MPI::Vector u(start), update(owned, communicator);
+    solution = u;
+    double r = assemble(solution, load_factor, strength_factor, Matrix::elastic);
+    SolverControl                  control(1, 0);
+    TrilinosWrappers::SolverDirect direct(control);
+    if (settings.linear_solver == "direct")
+      direct.initialize(elastic_stiffness);
+    for (unsigned int k = 0;; ++k)
+      {
+        report.residuals.push_back(r / load_norm);
+        if (!std::isfinite(r))
+          return false;
+        if (r <= settings.initial_stiffness_tolerance * load_norm)
+          return true;
+        if (k == settings.maximum_initial_stiffness_iterations)
+          return false;
+        update = 0;
+        if (settings.linear_solver == "direct")
+          {
+            direct.solve(update, residual);
+            constraints.distribute(update);
+          }
+        else
+          solve_linear(elastic_stiffness, update);
+        ++report.initial_stiffness_iterations;
+        if (std::getenv("MPM_DEBUG_IS") && k % 50 == 0 && Utilities::MPI::this_mpi_process(communicator) == 0)
+          std::cout << "      IS " << k << " " << r / load_norm << std::endl;
+        u.add(1.0, update);
+        solution = u;
+        r        = assemble(solution, load_factor, strength_factor, Matrix::none);
+      }
   }
 
   template <int dim>

@@ -24,7 +24,8 @@ namespace mpm::fem
   {
     free,  // no constraint
     roller, // the displacement normal to the (plane, axis-aligned) boundary fixed
-    fixed  // every displacement component fixed
+    fixed,  // every displacement component fixed
+    periodic // ids 2d and 2d + 1 (the bounding box's faces normal to axis d) tied to each other
   };
 
   struct PrefailureParameters
@@ -48,6 +49,8 @@ namespace mpm::fem
     // Newton
     unsigned int load_steps               = 4;
     unsigned int maximum_newton_iterations = 50;
+    unsigned int maximum_initial_stiffness_iterations = 1000; // after a failed Newton; 0 = none
+    double       initial_stiffness_tolerance          = 1e-5; // relative, as residual_tolerance
     double       residual_tolerance       = 1e-8; // relative to the full gravity load vector's norm
     bool         line_search              = true;
     std::string  linear_solver            = "direct"; // or "iterative" (GMRES + AMG)

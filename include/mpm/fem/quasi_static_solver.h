@@ -50,7 +50,11 @@ namespace mpm::fem
     // Residual norm relative to the full gravity load's, before each iteration and at the end.
     std::vector<double> residuals;
     unsigned int        line_search_halvings = 0;
-    double              wall_seconds         = 0;
+    bool                singular_tangent     = false; // the linear solver failed on the tangent
+    // Where Newton failed: the iterations of the initial-stiffness method that followed
+    // (0 when Newton converged or the fallback is off).
+    unsigned int initial_stiffness_iterations = 0;
+    double       wall_seconds                 = 0;
   };
 
   template <int dim>
@@ -97,12 +101,18 @@ namespace mpm::fem
     enum class Matrix
     {
       none,
-      tangent // the consistent tangent at u
+      tangent, // the consistent tangent at u
+      elastic  // the elastic stiffness (initial-stiffness iterations)
     };
     // -residual (and a matrix) at displacement u; returns |residual|.
     double assemble(const dealii::TrilinosWrappers::MPI::Vector &u, double load_factor, double strength_factor,
                     Matrix matrix);
     void   solve_linear(const dealii::TrilinosWrappers::SparseMatrix &A, dealii::TrilinosWrappers::MPI::Vector &update);
+    // From start (Newton's best iterate of this increment): u += K_e^-1 R(u) until |R| is
+    // below `Initial stiffness tolerance` x |f_ext| or `Maximum initial stiffness iterations`
+    // pass (K_e factorised once per call).
+    bool   solve_initial_stiffness(const dealii::TrilinosWrappers::MPI::Vector &start, double load_factor,
+                                   double strength_factor, NewtonReport &report);
     void   commit(double strength_factor);
     void   setup_constraints(const PrefailureParameters &parameters);
 
@@ -116,7 +126,7 @@ namespace mpm::fem
     dealii::QGauss<dim>                       quadrature_formula;
     dealii::IndexSet                          owned, relevant;
     dealii::AffineConstraints<double>         constraints;
-    dealii::TrilinosWrappers::SparseMatrix    tangent;
+    dealii::TrilinosWrappers::SparseMatrix    tangent, elastic_stiffness;
     dealii::TrilinosWrappers::MPI::Vector     residual;              // owned: -R
     dealii::TrilinosWrappers::MPI::Vector     solution, committed;  // ghosted
     dealii::TrilinosWrappers::MPI::Vector     monitor_reference;     // ghosted
