@@ -79,6 +79,8 @@ namespace mpm::fem
         AssertThrow(r.converged, ExcMessage("Pre-failure analysis: the equilibrium step after the K0 procedure did "
                                             "not converge within Maximum Newton iterations (" +
                                             std::to_string(p.maximum_newton_iterations) +
+                                            ") and Maximum initial stiffness iterations (" +
+                                            std::to_string(p.maximum_initial_stiffness_iterations) +
                                             "): the body cannot carry its weight with these strengths."));
         return;
       }
@@ -103,6 +105,8 @@ namespace mpm::fem
                     ExcMessage("Pre-failure analysis: gravity loading found no equilibrium beyond " +
                                std::to_string(100 * load) + "% of the weight (Newton did not converge within Maximum "
                                "Newton iterations = " + std::to_string(p.maximum_newton_iterations) +
+                               ", nor the initial-stiffness iterations within " +
+                               std::to_string(p.maximum_initial_stiffness_iterations) +
                                " even in steps of 1/" + std::to_string(p.load_steps << max_halvings) +
                                "): the body cannot carry its own weight" +
                                (strength_factor != 1 ? " at Minimum factor" : std::string()) +
@@ -137,7 +141,7 @@ namespace mpm::fem
           step /= 2;
         result.curve.push_back({factor, r.converged, r.iterations, r.residuals.back(),
                                 quasi_static->monitor_displacement(p.monitor_point), quasi_static->max_plastic_strain(),
-                                r.wall_seconds});
+                                r.wall_seconds, r.initial_stiffness_iterations});
         pcout << "    F = " << std::fixed << std::setprecision(4) << factor << std::defaultfloat << ": "
               << describe(r);
         if (r.converged)
@@ -165,11 +169,13 @@ namespace mpm::fem
     if (Utilities::MPI::this_mpi_process(communicator) != 0)
       return;
     std::ofstream out(parameters.output_directory + "/strength_reduction.csv");
-    out << "factor,converged,newton_iterations,relative_residual,monitor_displacement,max_plastic_strain,wall_s\n"
+    out << "factor,converged,newton_iterations,initial_stiffness_iterations,relative_residual,monitor_displacement,"
+           "max_plastic_strain,wall_s\n"
         << std::setprecision(10);
     for (const ReductionStep &s : result.curve)
-      out << s.factor << ',' << (s.converged ? 1 : 0) << ',' << s.iterations << ',' << s.residual << ','
-          << s.monitor_displacement << ',' << s.max_plastic_strain << ',' << s.wall_seconds << '\n';
+      out << s.factor << ',' << (s.converged ? 1 : 0) << ',' << s.iterations << ',' << s.initial_stiffness_iterations
+          << ',' << s.residual << ',' << s.monitor_displacement << ',' << s.max_plastic_strain << ',' << s.wall_seconds
+          << '\n';
     AssertThrow(out, ExcMessage("Cannot write " + parameters.output_directory + "/strength_reduction.csv."));
   }
 

@@ -102,9 +102,10 @@ namespace mpm::fem
                       "holds the sides by rollers.");
     prm.declare_entry("Load steps", "4", Patterns::Integer(1, 10000),
                       "Gravity loading: gravity is applied in this many equal increments.");
-    prm.declare_entry("Maximum Newton iterations", "50", Patterns::Integer(1, 10000),
-                      "Newton iterations of one load step or one factor before it counts as not converged "
-                      "(under strength reduction: the factor fails).");
+    prm.declare_entry("Maximum Newton iterations", "200", Patterns::Integer(1, 10000),
+                      "Newton iterations of one load step or one factor before Newton counts as not converged; "
+                      "then the initial-stiffness iterations try (Maximum initial stiffness iterations), and if "
+                      "they fail too, the load step is halved or, under strength reduction, the factor fails.");
     prm.declare_entry("Maximum initial stiffness iterations", "1000", Patterns::Integer(0, 1000000),
                       "Where Newton does not converge, the load step or factor is tried again from the last "
                       "converged state with the initial-stiffness method (the elastic stiffness, factorised "

@@ -29,6 +29,7 @@ namespace mpm::fem
     double       monitor_displacement; // m, since the start of the reduction (committed state)
     double       max_plastic_strain;   // of the committed state
     double       wall_seconds;
+    unsigned int initial_stiffness_iterations = 0; // after a failed Newton (quasi_static_solver.h)
   };
 
   struct PrefailureResult

@@ -48,7 +48,7 @@ namespace mpm::fem
 
     // Newton
     unsigned int load_steps               = 4;
-    unsigned int maximum_newton_iterations = 50;
+    unsigned int maximum_newton_iterations = 200;
     unsigned int maximum_initial_stiffness_iterations = 1000; // after a failed Newton; 0 = none
     double       initial_stiffness_tolerance          = 1e-5; // relative, as residual_tolerance
     double       residual_tolerance       = 1e-8; // relative to the full gravity load vector's norm
