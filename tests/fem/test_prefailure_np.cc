@@ -83,7 +83,7 @@ subsection Output
               std::array<double, 6> s;
               for (int c = 0; c < 6; ++c)
                 s[c] = solver.history(cell, q).stress[c];
-              result[{std::llround(x[0] * 1e9), std::llround(x[1] * 1e9)}] = s;
+              result[{{std::llround(x[0] * 1e9), std::llround(x[1] * 1e9)}}] = s;
             }
         }
     return result;
