@@ -28,7 +28,7 @@ namespace mpm::fem
       if (r.line_search_halvings)
         s << ", " << r.line_search_halvings << " line-search halving(s)";
       if (r.singular_tangent)
-        s << ", singular tangent";
+        s << ", the tangent's linear solve failed";
       if (r.initial_stiffness_iterations)
         s << "; then " << r.initial_stiffness_iterations << " initial-stiffness iteration(s)";
       s << std::defaultfloat << std::setprecision(3) << " (" << r.wall_seconds << " s)";
@@ -124,13 +124,13 @@ namespace mpm::fem
     result.curve.push_back({p.minimum_factor, true, result.initial_steps.back().iterations,
                             result.initial_steps.back().residuals.back(), 0.0, quasi_static->max_plastic_strain(),
                             0.0});
-    // Adaptive steps in F from the last converged factor: a factor whose Newton fails halves
+    // Adaptive steps in F from the last converged factor: a factor that fails halves
     // the step (the failed factor is tried again from nearer once a smaller step converges);
-    // F fails for good when even a step below Factor tolerance does. Every trial starts from
+    // the search ends when the step is halved below Factor tolerance. Every trial starts from
     // the committed state of the last converged factor.
     double low = p.minimum_factor, high = 0, step = p.factor_increment;
     pcout << "  strength reduction: F from " << low << " in steps of " << p.factor_increment
-          << ", halved where Newton fails, down to " << p.factor_tolerance << std::endl;
+          << ", halved where a factor fails, down to " << p.factor_tolerance << std::endl;
     while (step >= p.factor_tolerance && low < p.maximum_factor)
       {
         const double       factor = std::min(low + step, p.maximum_factor);

@@ -70,7 +70,8 @@ namespace mpm::fem
       "Newton with the consistent tangent of the materials' return mappings. K0 procedure: vertical stress "
       "from the overburden of horizontal layers, horizontal stress K0 times it, then one equilibrium step "
       "(exact for horizontal ground). strength reduction: the stresses of 'Initial stresses', then c, "
-      "tan(phi) and tan(psi) divided by a factor F raised until Newton fails: the factor of safety.");
+      "tan(phi) and tan(psi) divided by a factor F raised until no equilibrium is found (Newton and the "
+      "initial-stiffness iterations both fail): the factor of safety.");
     prm.declare_entry("Initial stresses", "gravity loading", Patterns::Selection("gravity loading|K0 procedure"),
                       "Method = strength reduction: how the stresses before the reduction are made, at F = "
                       "Minimum factor.");
@@ -93,7 +94,8 @@ namespace mpm::fem
                       "over-predict the factor of safety) or 1.");
     prm.declare_entry("Boundary conditions",
                       dim == 2 ? "0: roller; 1: roller; 2: fixed" : "0: roller; 1: roller; 2: roller; 3: roller; 4: fixed",
-                      Patterns::Anything(),
+                      Patterns::Map(Patterns::Integer(0, 254), Patterns::Selection("fixed|roller|periodic|free"), 0,
+                                    Patterns::Map::max_int_value, ";", ":"),
                       "'id: condition; ...' with condition fixed (every displacement component zero), roller "
                       "(the component normal to the boundary zero; the boundary must be a plane normal to an "
                       "axis), periodic (ids 2d and 2d+1, the opposite faces of the body's bounding box normal to "
@@ -107,8 +109,8 @@ namespace mpm::fem
                       "then the initial-stiffness iterations try (Maximum initial stiffness iterations), and if "
                       "they fail too, the load step is halved or, under strength reduction, the factor fails.");
     prm.declare_entry("Maximum initial stiffness iterations", "1000", Patterns::Integer(0, 1000000),
-                      "Where Newton does not converge, the load step or factor is tried again from the last "
-                      "converged state with the initial-stiffness method (the elastic stiffness, factorised "
+                      "Where Newton does not converge, the load step or factor is tried again from Newton's "
+                      "iterate of least residual with the initial-stiffness method (the elastic stiffness, factorised "
                       "once; Griffiths & Lane's iteration), up to this many iterations; it is slower but does "
                       "not cycle where non-associated plasticity makes Newton cycle. 0: Newton only.");
     prm.declare_entry("Initial stiffness tolerance", "1e-5", Patterns::Double(0),
@@ -132,14 +134,15 @@ namespace mpm::fem
     prm.declare_entry("Minimum factor", "1", Patterns::Double(0),
                       "Strength reduction: the factor F of the initial stresses (> 0), where the search starts.");
     prm.declare_entry("Maximum factor", "10", Patterns::Double(0),
-                      "Strength reduction: the search stops here if Newton has not failed by then (reported as a "
+                      "Strength reduction: the search stops here if no factor has failed by then (reported as a "
                       "factor of safety above it).");
     prm.declare_entry("Factor increment", "0.1", Patterns::Double(0),
-                      "Strength reduction: F is raised by this much from each converged factor until Newton fails; "
-                      "then the bracket is halved.");
+                      "Strength reduction: F is raised by this much from each converged factor; where a factor "
+                      "fails, the step is halved and the failed factor is tried again from nearer.");
     prm.declare_entry("Factor tolerance", "0.005", Patterns::Double(0),
-                      "Strength reduction: bisection stops when the failing and the last converged factor differ "
-                      "by less than this; the factor of safety is the last converged one.");
+                      "Strength reduction: the search stops when the step has been halved below this; the last "
+                      "converged factor (the factor of safety) and the lowest failing one then differ by less "
+                      "than twice this.");
     prm.declare_entry("Monitor point", "", Patterns::Anything(),
                       "Strength reduction: the F-displacement curve reads the displacement (since the start of "
                       "the reduction) of the mesh vertex nearest this point, e.g. the crest; empty = the largest "

@@ -10,6 +10,7 @@
 #include <deal.II/fe/fe_values.h>
 #include <deal.II/lac/dynamic_sparsity_pattern.h>
 #include <deal.II/lac/full_matrix.h>
+#include <deal.II/lac/solver_cg.h>
 #include <deal.II/lac/solver_control.h>
 #include <deal.II/lac/solver_gmres.h>
 #include <deal.II/lac/sparsity_tools.h>
@@ -145,6 +146,9 @@ namespace mpm::fem
     for (const auto &[id, condition] : parameters.boundary_conditions)
       if (condition == BoundaryCondition::periodic && id % 2 == 0)
         DoFTools::make_periodicity_constraints(dofs, id, id + 1, id / 2, constraints);
+    // Axes along which some fixed or roller boundary holds the body (bit d): without one, the
+    // body could translate freely and no equilibrium exists.
+    unsigned int held_axes = 0;
     // Which axes each roller boundary is a plane normal to: every face of the id spans zero
     // along the axis (bit d set), over every rank.
     for (const auto &[id, condition] : parameters.boundary_conditions)
@@ -177,6 +181,7 @@ namespace mpm::fem
                         << ", which no boundary face of this mesh has; ignored." << std::endl;
             continue;
           }
+        held_axes |= condition == BoundaryCondition::fixed ? (1u << dim) - 1 : normal_axes;
         if (condition == BoundaryCondition::fixed)
           VectorTools::interpolate_boundary_values(dofs, id, Functions::ZeroFunction<dim>(dim), constraints);
         else
@@ -193,6 +198,17 @@ namespace mpm::fem
             mask.set(axis, true);
             VectorTools::interpolate_boundary_values(dofs, id, Functions::ZeroFunction<dim>(dim), constraints, mask);
           }
+      }
+    if (held_axes != (1u << dim) - 1)
+      {
+        std::string free_axes;
+        for (int d = 0; d < dim; ++d)
+          if (!(held_axes & (1u << d)))
+            free_axes += std::string(free_axes.empty() ? "" : ", ") + "xyz"[d];
+        AssertThrow(false, ExcMessage("Parameter 'Pre-failure analysis/Boundary conditions': no fixed or roller "
+                                      "boundary of the mesh holds the body along " + free_axes +
+                                      ", so it could move freely and has no equilibrium; fix a boundary (e.g. the "
+                                      "base: '" + std::to_string(2 * (dim - 1)) + ": fixed')."));
       }
     constraints.close();
   }
@@ -286,6 +302,19 @@ namespace mpm::fem
   }
 
   template <int dim>
+  TrilinosWrappers::PreconditionAMG::AdditionalData QuasiStaticSolver<dim>::amg_settings() const
+  {
+    TrilinosWrappers::PreconditionAMG::AdditionalData data;
+    std::vector<std::vector<bool>>                    modes;
+    DoFTools::extract_constant_modes(dofs, ComponentMask(dim, true), modes);
+    data.constant_modes        = modes;
+    data.elliptic              = true;
+    data.higher_order_elements = settings.degree > 1;
+    data.smoother_sweeps       = 2;
+    return data;
+  }
+
+  template <int dim>
   void QuasiStaticSolver<dim>::solve_linear(const TrilinosWrappers::SparseMatrix &tangent,
                                             TrilinosWrappers::MPI::Vector &update)
   {
@@ -297,15 +326,8 @@ namespace mpm::fem
       }
     else
       {
-        TrilinosWrappers::PreconditionAMG                 amg;
-        TrilinosWrappers::PreconditionAMG::AdditionalData data;
-        std::vector<std::vector<bool>>                    modes;
-        DoFTools::extract_constant_modes(dofs, ComponentMask(dim, true), modes);
-        data.constant_modes        = modes;
-        data.elliptic              = true;
-        data.higher_order_elements = settings.degree > 1;
-        data.smoother_sweeps       = 2;
-        amg.initialize(tangent, data);
+        TrilinosWrappers::PreconditionAMG amg;
+        amg.initialize(tangent, amg_settings());
         SolverGMRES<TrilinosWrappers::MPI::Vector> gmres(control, SolverGMRES<TrilinosWrappers::MPI::Vector>::AdditionalData(100));
         gmres.solve(tangent, update, residual, amg);
       }
@@ -391,10 +413,23 @@ namespace mpm::fem
     TrilinosWrappers::MPI::Vector u(start), update(owned, communicator);
     solution = u;
     double r = assemble(solution, load_factor, strength_factor, Matrix::elastic);
-    SolverControl                  control(1, 0);
-    TrilinosWrappers::SolverDirect direct(control);
-    if (settings.linear_solver == "direct")
-      direct.initialize(elastic_stiffness);
+    // K_e is factorised (or its AMG built) once for all iterations; a failure of the solver
+    // (a singular K_e) ends the attempt like a non-converged one.
+    const bool                        direct_solver = settings.linear_solver == "direct";
+    SolverControl                     control(1, 0);
+    TrilinosWrappers::SolverDirect    direct(control);
+    TrilinosWrappers::PreconditionAMG amg;
+    try
+      {
+        if (direct_solver)
+          direct.initialize(elastic_stiffness);
+        else
+          amg.initialize(elastic_stiffness, amg_settings());
+      }
+    catch (const ExceptionBase &)
+      {
+        return false;
+      }
     for (unsigned int k = 0;; ++k)
       {
         report.residuals.push_back(r / load_norm);
@@ -405,16 +440,24 @@ namespace mpm::fem
         if (k == settings.maximum_initial_stiffness_iterations)
           return false;
         update = 0;
-        if (settings.linear_solver == "direct")
+        try
           {
-            direct.solve(update, residual);
-            constraints.distribute(update);
+            if (direct_solver)
+              direct.solve(update, residual);
+            else
+              {
+                // K_e is symmetric positive definite: CG
+                SolverControl                            cg_control(5000, 1e-12 * residual.l2_norm());
+                SolverCG<TrilinosWrappers::MPI::Vector> cg(cg_control);
+                cg.solve(elastic_stiffness, update, residual, amg);
+              }
           }
-        else
-          solve_linear(elastic_stiffness, update);
+        catch (const ExceptionBase &)
+          {
+            return false;
+          }
+        constraints.distribute(update);
         ++report.initial_stiffness_iterations;
-        if (std::getenv("MPM_DEBUG_IS") && k % 50 == 0 && Utilities::MPI::this_mpi_process(communicator) == 0)
-          std::cout << "      IS " << k << " " << r / load_norm << std::endl;
         u.add(1.0, update);
         solution = u;
         r        = assemble(solution, load_factor, strength_factor, Matrix::none);

@@ -12,6 +12,8 @@
 #include <mpm/dealii/parameters.h>
 #include <mpm/fem/prefailure_analysis.h>
 
+#include "v7_slope_prm.h"
+
 #include <deal.II/base/mpi.h>
 #include <deal.II/fe/fe_values.h>
 
@@ -112,45 +114,8 @@ namespace
 
   void newton_rate()
   {
-    const std::string prm = R"(
-set Dimension = 2
-subsection Grid
-  set Lower corner = 0, 0
-  set Upper corner = 60, 14
-  set Cell size = 1
-end
-subsection Solver
-  set Gravity = 0, -9.81
-end
-subsection Material soil
-  set Model = drucker prager
-  subsection drucker prager
-    set Young's modulus = 1e8
-    set Poisson's ratio = 0.3
-    set Cohesion        = 10e3
-    set Friction angle  = 20
-    set Dilatancy angle = 0
-  end
-end
-subsection Material points
-  subsection Body 1
-    set Shape            = polygon
-    set Polygon vertices = 0, 0; 40, 0; 20, 10; 0, 10
-    set Upper corner     = 40, 10
-    set Density          = 2038.7359836901
-  end
-end
-subsection Pre-failure analysis
-  set Method = gravity loading
-  set Cell size = 2
-  set Load steps = 2
-  set Residual tolerance = 1e-12
-  set Continue with MPM = false
-end
-subsection Output
-  set Directory = test-prefailure-output
-end
-)";
+    const std::string prm = v7_drucker_prager_slope("  set Method = gravity loading\n  set Residual tolerance = 1e-12",
+                                                    "test-prefailure-output");
     mpm::fem::PrefailureAnalysis<2> analysis(mpm::parameters_from_string(prm), MPI_COMM_WORLD);
     const mpm::fem::PrefailureResult result = analysis.run();
     const std::vector<double>       &r      = result.initial_steps.back().residuals;

@@ -8,6 +8,8 @@
 #include <mpm/dealii/parameters.h>
 #include <mpm/fem/prefailure_analysis.h>
 
+#include "v7_slope_prm.h"
+
 #include <deal.II/base/mpi.h>
 #include <deal.II/fe/fe_values.h>
 
@@ -28,42 +30,7 @@ namespace
 
   std::string slope(const std::string &directory)
   {
-    return R"(
-set Dimension = 2
-subsection Grid
-  set Lower corner = 0, 0
-  set Upper corner = 60, 14
-  set Cell size = 1
-end
-subsection Solver
-  set Gravity = 0, -9.81
-end
-subsection Material soil
-  set Model = drucker prager
-  subsection drucker prager
-    set Young's modulus = 1e8
-    set Poisson's ratio = 0.3
-    set Cohesion        = 10e3
-    set Friction angle  = 20
-    set Dilatancy angle = 0
-  end
-end
-subsection Material points
-  subsection Body 1
-    set Shape            = polygon
-    set Polygon vertices = 0, 0; 40, 0; 20, 10; 0, 10
-    set Upper corner     = 40, 10
-    set Density          = 2038.7359836901
-  end
-end
-subsection Pre-failure analysis
-  set Method = strength reduction
-  set Cell size = 2
-  set Load steps = 2
-  set Continue with MPM = false
-end
-subsection Output
-  set Directory = )" + directory + "\nend\n";
+    return v7_drucker_prager_slope("  set Method = strength reduction", directory);
   }
 
   using Stresses = std::map<std::array<long long, 2>, std::array<double, 6>>;

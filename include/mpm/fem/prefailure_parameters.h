@@ -58,8 +58,9 @@ namespace mpm::fem
     // K0 procedure: K0 of every material; < 0 = nu / (1 - nu) of each.
     double k0 = -1;
 
-    // Strength reduction: F from minimum_factor upwards by factor_increment until Newton fails,
-    // then bisection to factor_tolerance; no failure up to maximum_factor is reported as such.
+    // Strength reduction: F from minimum_factor upwards in steps of factor_increment, the step
+    // halved where a factor fails, until it is below factor_tolerance; no failure up to
+    // maximum_factor is reported as such.
     double minimum_factor   = 1;
     double maximum_factor   = 10;
     double factor_increment = 0.1;

@@ -2,7 +2,8 @@
 // on a parallel::distributed::Triangulation (deal.II's step-42 is the pattern). Displacement
 // FE_Q(p)^dim; at each quadrature point the core's update (small_strain_update.h: the very
 // return mappings of the MPM step) and its consistent tangent; Newton with a backtracking line
-// search; Trilinos matrices, Amesos KLU or GMRES + AMG. Plane strain in 2D (the out-of-plane
+// search, and where Newton fails the initial-stiffness method; Trilinos matrices, Amesos KLU or
+// GMRES + AMG. Plane strain in 2D (the out-of-plane
 // stress is carried at every quadrature point). Theory: doc/prefailure.md.
 //
 //   QuasiStaticSolver<2> solver(triangulation, materials, parameters.prefailure, parameters.gravity);
@@ -11,7 +12,7 @@
 //   solver.solve(1.0, 1.4);                  // the same with c and tan(phi) divided by 1.4
 //
 // solve() starts from the committed state (displacement and quadrature-point history) and
-// commits the new one only where Newton converges: a failed factor leaves the last state.
+// commits the new one only where it converges: a failed factor leaves the last state.
 #pragma once
 
 #include <mpm/core/config.h>
@@ -25,6 +26,7 @@
 #include <deal.II/dofs/dof_handler.h>
 #include <deal.II/fe/fe_system.h>
 #include <deal.II/lac/affine_constraints.h>
+#include <deal.II/lac/trilinos_precondition.h>
 #include <deal.II/lac/trilinos_sparse_matrix.h>
 #include <deal.II/lac/trilinos_vector.h>
 
@@ -67,7 +69,8 @@ namespace mpm::fem
                       const PrefailureParameters &parameters, const std::vector<double> &gravity);
 
     // Equilibrium under load_factor x gravity with every strength divided by strength_factor,
-    // from the committed state; commits the result if Newton converges.
+    // from the committed state: Newton, then (if it fails) the initial-stiffness iterations;
+    // commits the result if either converges.
     NewtonReport solve(double load_factor, double strength_factor);
 
     // The K0 procedure's stresses: sigma_v = -|g| x the overburden of horizontal layers (the
@@ -89,8 +92,8 @@ namespace mpm::fem
     // The state function of the hand-over (fem_handover.h) over this history.
     QuadraturePointStateFunction<dim> state_function() const;
 
-    // The committed state as .vtu/.pvtu (displacement; cell averages of the stress, the plastic
-    // strain and the yielded fraction); returns the .pvtu's name.
+    // The committed state as .vtu/.pvtu (displacement; cell averages of the stress and the
+    // plastic strain; material id, subdomain); returns the .pvtu's path.
     std::string write_output(const std::string &directory, const std::string &name) const;
 
     dealii::types::global_dof_index n_dofs() const;
@@ -108,6 +111,8 @@ namespace mpm::fem
     double assemble(const dealii::TrilinosWrappers::MPI::Vector &u, double load_factor, double strength_factor,
                     Matrix matrix);
     void   solve_linear(const dealii::TrilinosWrappers::SparseMatrix &A, dealii::TrilinosWrappers::MPI::Vector &update);
+    // Trilinos AMG for this displacement field (vector-valued, rigid translations as constant modes).
+    dealii::TrilinosWrappers::PreconditionAMG::AdditionalData amg_settings() const;
     // From start (Newton's best iterate of this increment): u += K_e^-1 R(u) until |R| is
     // below `Initial stiffness tolerance` x |f_ext| or `Maximum initial stiffness iterations`
     // pass (K_e factorised once per call).
