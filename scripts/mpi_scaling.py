@@ -21,6 +21,7 @@ parser.add_argument("--np", default="1,2")
 parser.add_argument("--steps", type=int, default=400)
 parser.add_argument("--repeat", type=int, default=3)
 parser.add_argument("--mpirun-args", default="")
+parser.add_argument("--backend", default="", help="cpu or cuda (default: the scene's)")
 parser.add_argument("--threads", type=int, default=0,
                     help="threads per rank (DEAL_II_NUM_THREADS, which also bounds the CPU backend's TBB loops); "
                          "0 = deal.II's default, the cores divided among the ranks of a node")
@@ -38,6 +39,8 @@ with tempfile.TemporaryDirectory() as work:
                   f"subsection Output\n  set Directory = {work}/out\n  set Output interval = 0\n"
                   "  set Write grid fields = false\n  set Write particles = false\n"
                   "  set Progress interval = 0\nend\n")
+        if args.backend:
+            out.write(f"subsection Backend\n  set Backend = {args.backend}\nend\n")
     for np_ in [int(n) for n in args.np.split(",")]:
         best = None
         for _ in range(args.repeat):
@@ -63,7 +66,7 @@ with tempfile.TemporaryDirectory() as work:
 
 base = rows[0]["wall"] * rows[0]["np"]
 load = open("/proc/loadavg").read().split()[:3] if os.path.exists("/proc/loadavg") else ["?"]
-print(f"scene {os.path.basename(args.prm)}, {rows[0]['points']} points, {args.steps} steps, best of {args.repeat}, "
+print(f"scene {os.path.basename(args.prm)}{', backend ' + args.backend if args.backend else ''}, {rows[0]['points']} points, {args.steps} steps, best of {args.repeat}, "
       f"threads per rank {args.threads or 'default'}, {os.cpu_count()} cores, load average {' '.join(load)}")
 print(f"{'ranks':>5} {'wall s':>8} {'step s':>8} {'steps/s':>8} {'pt-upd/s':>10} {'speed-up':>8} {'effic.':>7} "
       f"{'re-sorts':>8} {'repart.':>7} {'ghosts':>7} {'kB/step':>8}")

@@ -165,7 +165,7 @@ namespace mpm
     cell_partitioner = distributed ? distributed->global_active_cell_index_partitioner().lock() :
                                      std::make_shared<const dealii::Utilities::MPI::Partitioner>(
                                        triangulation.n_active_cells());
-    lattice_cell_of_local_cell.assign(cell_partitioner->locally_owned_size() + cell_partitioner->n_ghost_indices(),
+    lattice_cell_of_local_cell_index.assign(cell_partitioner->locally_owned_size() + cell_partitioner->n_ghost_indices(),
                                       -1);
 
     // Owned and ghost cells: their vertices are exactly the locally relevant nodes.
@@ -173,7 +173,7 @@ namespace mpm
       {
         if (cell->is_artificial())
           continue;
-        lattice_cell_of_local_cell[cell_partitioner->global_to_local(cell->global_active_cell_index())] =
+        lattice_cell_of_local_cell_index[cell_partitioner->global_to_local(cell->global_active_cell_index())] =
           lattice_index(cell->center(), true);
         if (cell->is_locally_owned())
           cell_of_lattice_cell[lattice_index(cell->center(), true)] = cell;
@@ -262,6 +262,44 @@ namespace mpm
 
   namespace
   {
+    // Ghost entries and import entries (ranges of owned ones) of a partitioner, ascending.
+    std::vector<unsigned int> touched_by_exchange(const dealii::Utilities::MPI::Partitioner &partitioner)
+    {
+      std::vector<unsigned int> local;
+      for (const auto &range : partitioner.import_indices())
+        for (unsigned int i = range.first; i < range.second; ++i)
+          local.push_back(i);
+      std::sort(local.begin(), local.end());
+      local.erase(std::unique(local.begin(), local.end()), local.end());
+      const unsigned int n_owned = partitioner.locally_owned_size();
+      for (unsigned int g = 0; g < partitioner.n_ghost_indices(); ++g)
+        local.push_back(n_owned + g);
+      return local;
+    }
+  } // namespace
+
+  template <int dim>
+  std::vector<unsigned int> BackgroundGrid<dim>::exchanged_local_nodes() const
+  {
+    return touched_by_exchange(*partitioner);
+  }
+
+  template <int dim>
+  std::vector<unsigned int> BackgroundGrid<dim>::exchanged_local_cells() const
+  {
+    return touched_by_exchange(*cell_partitioner);
+  }
+
+  template <int dim>
+  template <typename Real>
+  void BackgroundGrid<dim>::sum_local_cells(Real *const *arrays, const int count) const
+  {
+    if (n_ranks > 1)
+      exchange_add(*cell_partitioner, arrays, count);
+  }
+
+  namespace
+  {
     template <typename Real>
     std::vector<Real> &buffer_of(std::vector<double> &d, std::vector<float> &f);
     template <>
@@ -301,7 +339,7 @@ namespace mpm
   {
     if (n_ranks == 1)
       return;
-    const std::size_t  n_local = lattice_cell_of_local_cell.size();
+    const std::size_t  n_local = lattice_cell_of_local_cell_index.size();
     std::vector<Real> &buffer  = buffer_of<Real>(cell_buffer_double, cell_buffer_float);
     buffer.resize(count * n_local);
     std::vector<Real *> local(count);
@@ -309,12 +347,12 @@ namespace mpm
       {
         local[i] = buffer.data() + i * n_local;
         for (std::size_t c = 0; c < n_local; ++c)
-          local[i][c] = arrays[i][lattice_cell_of_local_cell[c]];
+          local[i][c] = arrays[i][lattice_cell_of_local_cell_index[c]];
       }
     exchange_add(*cell_partitioner, local.data(), count);
     for (int i = 0; i < count; ++i)
       for (std::size_t c = 0; c < n_local; ++c)
-        arrays[i][lattice_cell_of_local_cell[c]] = local[i][c];
+        arrays[i][lattice_cell_of_local_cell_index[c]] = local[i][c];
   }
 
   template <int dim>
@@ -357,6 +395,8 @@ namespace mpm
   template void BackgroundGrid<3>::sum_nodal(double *const *, int) const;
   template void BackgroundGrid<2>::sum_nodal(float *const *, int) const;
   template void BackgroundGrid<3>::sum_nodal(float *const *, int) const;
+  template void BackgroundGrid<2>::sum_local_cells(double *const *, int) const;
+  template void BackgroundGrid<3>::sum_local_cells(double *const *, int) const;
   template void BackgroundGrid<2>::sum_cells(double *const *, int) const;
   template void BackgroundGrid<3>::sum_cells(double *const *, int) const;
   template void BackgroundGrid<2>::sum_cells(float *const *, int) const;

@@ -5,9 +5,16 @@
 
 #include <deal.II/base/exceptions.h>
 
+#include <deal.II/base/mpi.h>
+
 #ifdef MPM_CUDA_ENGINE
 #  include <mpm/cuda/device_engine.h>
 
+#  if __has_include(<mpi-ext.h>)
+#    include <mpi-ext.h> // Open MPI: MPIX_CUDA_AWARE_SUPPORT
+#  endif
+
+#  include <algorithm>
 #  include <iostream>
 #endif
 
@@ -16,37 +23,122 @@ namespace mpm
 #ifdef MPM_CUDA_ENGINE
   namespace
   {
+    // The host side of the device's nodal exchange on several ranks: the packed ghost and
+    // import entries go into the partitioner's local layout (host scratch, only those
+    // entries are read or written), deal.II's Partitioner sums them over the ranks
+    // (BackgroundGrid::Exchange), and the sums go back into the packed array.
+    template <int dim>
+    class GridExchange : public cuda::NodalExchange
+    {
+    public:
+      explicit GridExchange(const BackgroundGrid<dim> &grid)
+        : grid(grid)
+        , nodes(grid.exchanged_local_nodes())
+        , cells(grid.exchanged_local_cells())
+        , n_local_nodes(grid.partitioner->locally_owned_size() + grid.partitioner->n_ghost_indices())
+        , n_local_cells(grid.cell_partitioner->locally_owned_size() + grid.cell_partitioner->n_ghost_indices())
+      {}
+
+      std::vector<int> exchanged_nodes() const override { return std::vector<int>(nodes.begin(), nodes.end()); }
+
+      std::vector<long> exchanged_cells() const override
+      {
+        std::vector<long> lattice(cells.size());
+        for (std::size_t j = 0; j < cells.size(); ++j)
+          lattice[j] = grid.lattice_cell_of_local_cell(cells[j]);
+        return lattice;
+      }
+
+      void sum_nodal(double *values, const int count) override
+      {
+        sum(values, count, nodes, n_local_nodes,
+            [this](double *const *arrays, const int c) { grid.exchange().sum_nodal(arrays, c); });
+      }
+
+      void sum_cells(double *values, const int count) override
+      {
+        sum(values, count, cells, n_local_cells,
+            [this](double *const *arrays, const int c) { grid.sum_local_cells(arrays, c); });
+      }
+
+      // Bytes one rank moves between device and host per array of one exchange (each way).
+      std::size_t staged_bytes_per_array() const { return sizeof(double) * nodes.size(); }
+
+    private:
+      const BackgroundGrid<dim>       &grid;
+      const std::vector<unsigned int> nodes, cells;
+      const std::size_t               n_local_nodes, n_local_cells;
+      std::vector<double>             scratch;
+
+      template <typename Exchange>
+      void sum(double *values, const int count, const std::vector<unsigned int> &local, const std::size_t n_local,
+               Exchange &&exchange)
+      {
+        const std::size_t n = local.size();
+        scratch.resize(count * n_local);
+        std::vector<double *> arrays(count);
+        for (int k = 0; k < count; ++k)
+          {
+            arrays[k] = scratch.data() + k * n_local;
+            for (std::size_t j = 0; j < n; ++j)
+              arrays[k][local[j]] = values[k * n + j];
+          }
+        exchange(arrays.data(), count);
+        for (int k = 0; k < count; ++k)
+          for (std::size_t j = 0; j < n; ++j)
+            values[k * n + j] = arrays[k][local[j]];
+      }
+    };
+
     template <int dim>
     class CudaEngine : public Engine<dim>
     {
     public:
-      // One rank: no ghost nodes, no exchange. The MPI version will pass a NodalExchange
-      // that sums ghost contributions on the device buffers.
+      // One rank: the device keeps the lattice's nodes, no ghost nodes, no exchange.
       CudaEngine(HostGrid<dim, double> lattice, const std::vector<MaterialParameters<double>> &materials,
                  const ShapeFunction shape)
-        : device(make_grid_view<dim, double>(lattice), materials, shape, nullptr)
-      {}
+        : materials(materials)
+        , shape(shape)
+      {
+        device = std::make_unique<cuda::DeviceEngine<dim>>(make_grid_view<dim, double>(lattice), materials, shape,
+                                                           nullptr);
+      }
+
+      // Several ranks: the device keeps this rank's locally relevant nodes, numbered as the
+      // grid's vectors, and sums them over the ranks through the grid's partitioner.
+      CudaEngine(BackgroundGrid<dim> &grid, const std::vector<MaterialParameters<double>> &materials,
+                 const ShapeFunction shape)
+        : shared_grid(&grid)
+        , materials(materials)
+        , shape(shape)
+      {
+        build_on_grid();
+      }
 
       void load(const MaterialPoints<dim> &p) override
       {
+        // A repartition renumbered the nodes: the device's grid and exchange follow.
+        if (shared_grid != nullptr && shared_grid->partitioner != built_for)
+          build_on_grid();
         auto new_labels = std::make_shared<PointLabels<dim>>();
-        p.copy_to(host, nullptr, new_labels.get());
+        p.copy_to(host, shared_grid != nullptr ? &home_cells : nullptr, new_labels.get());
         load(host, std::move(new_labels));
+        if (shared_grid != nullptr)
+          device->set_home_cells(home_cells);
       }
 
       void load(const HostPoints<dim, double> &p, std::shared_ptr<const PointLabels<dim>> new_labels) override
       {
         labels = std::move(new_labels); // a snapshot being written keeps the old ones
-        device.upload_points(p);
+        device->upload_points(p);
       }
 
-      // Hand-over to the handler (an MPI re-sort; the CUDA engine runs on one rank, where
-      // nothing calls it yet): points come back, points that left the grid are removed,
-      // the handler's new order goes back down.
+      // Hand-over to the handler (an MPI re-sort): points come back, points that left the
+      // grid are removed, the handler's new order goes back down.
       unsigned int store(MaterialPoints<dim> &p) override
       {
-        host.resize(device.n_points());
-        device.download_points(host);
+        host.resize(device->n_points());
+        device->download_points(host);
         const unsigned int removed = p.copy_from(host);
         load(p);
         return removed;
@@ -56,39 +148,117 @@ namespace mpm
       // contract), which is the labels' order.
       void snapshot(PointSnapshot<dim> &s) override
       {
-        s.points.resize(device.n_points());
-        device.download_points(s.points);
+        s.points.resize(device->n_points());
+        device->download_points(s.points);
         s.labels = labels;
       }
 
-      // The device's lattice-ordered nodes into the grid's numbering.
-      void nodal_to(BackgroundGrid<dim> &grid) override { device.download_nodal(grid.view()); }
+      // The device's nodes into the grid's numbering.
+      void nodal_to(BackgroundGrid<dim> &grid) override { device->download_nodal(grid.view()); }
 
       StepReduction<double> step(const StepSettings<dim, double> &s, const double dt) override
       {
-        return device.step(s, dt);
+        return device->step(s, dt);
       }
 
-      PointTotals<dim, double> totals() override { return device.totals(); }
+      PointTotals<dim, double> totals() override { return device->totals(); }
 
-      // For the MPI re-sort; the simulator asks only on more than one rank, which this
-      // engine refuses for now.
       double max_distance_outside_home_cells() override
       {
-        AssertThrow(false, dealii::ExcMessage("Backend = cuda runs on one MPI rank only for now: points do not "
-                                              "migrate between ranks on the device yet."));
-        return 0;
+        AssertThrow(shared_grid != nullptr,
+                    dealii::ExcMessage("Internal: the home cells are known only for points loaded from the "
+                                       "ParticleHandler."));
+        return device->max_distance_outside_home_cells();
       }
 
-      void set_materials(const std::vector<MaterialParameters<double>> &m) override { device.set_materials(m); }
+      void set_materials(const std::vector<MaterialParameters<double>> &m) override
+      {
+        materials = m;
+        device->set_materials(m);
+      }
 
-      void set_sort_interval(const int steps) override { device.set_sort_interval(steps); }
+      void set_sort_interval(const int steps) override
+      {
+        sort_interval = steps;
+        device->set_sort_interval(steps);
+      }
 
     private:
-      cuda::DeviceEngine<dim>   device;
-      HostPoints<dim, double>   host; // staging for load/store from the handler only
-      std::shared_ptr<const PointLabels<dim>> labels; // id, initial position, in the uploaded order
+      BackgroundGrid<dim>                    *shared_grid = nullptr;
+      std::vector<MaterialParameters<double>> materials; // the latest table, for a rebuild
+      ShapeFunction                           shape;
+      int                                     sort_interval = -1; // -1: the device's default
+      // The partition the device's nodes were built for (kept alive, so a new one cannot
+      // reuse its address).
+      std::shared_ptr<const dealii::Utilities::MPI::Partitioner> built_for;
+      std::unique_ptr<GridExchange<dim>>      exchange; // declared before device: outlives it
+      std::unique_ptr<cuda::DeviceEngine<dim>> device;
+      HostPoints<dim, double>                 host;       // staging for load/store from the handler only
+      std::vector<long>                       home_cells; // several ranks: lattice cell of each point at load
+      std::shared_ptr<const PointLabels<dim>> labels;     // id, initial position, in the uploaded order
+
+      void build_on_grid()
+      {
+        device.reset();
+        exchange  = std::make_unique<GridExchange<dim>>(*shared_grid);
+        built_for = shared_grid->partitioner;
+        device    = std::make_unique<cuda::DeviceEngine<dim>>(shared_grid->view(), materials, shape, exchange.get());
+        if (sort_interval >= 0)
+          device->set_sort_interval(sort_interval);
+      }
     };
+
+    // The rank's place on its node: ranks of one node share its GPUs.
+    int node_local_rank(const MPI_Comm communicator)
+    {
+      MPI_Comm node;
+      MPI_Comm_split_type(communicator, MPI_COMM_TYPE_SHARED, 0, MPI_INFO_NULL, &node);
+      int rank = 0;
+      MPI_Comm_rank(node, &rank);
+      MPI_Comm_free(&node);
+      return rank;
+    }
+
+    bool mpi_is_cuda_aware()
+    {
+#  if defined(MPIX_CUDA_AWARE_SUPPORT) && MPIX_CUDA_AWARE_SUPPORT
+      return MPIX_Query_cuda_support() == 1;
+#  else
+      return false;
+#  endif
+    }
+
+    // Every rank's check for a usable device, refused on all ranks together.
+    void check_device(const MPI_Comm communicator)
+    {
+      std::string why;
+      const bool  usable = cuda::device_count(&why) > 0;
+      const bool  all    = dealii::Utilities::MPI::min(usable ? 1 : 0, communicator) == 1;
+      AssertThrow(usable, dealii::ExcMessage("Parameter 'Backend/Backend': 'cuda' was asked for, but no CUDA device "
+                                             "is usable (" + why + "). Use 'cpu', or run on a machine with an "
+                                             "NVIDIA GPU and driver."));
+      AssertThrow(all, dealii::ExcMessage("Parameter 'Backend/Backend': 'cuda' was asked for, but another MPI rank "
+                                          "found no usable CUDA device (its message says why)."));
+    }
+
+    void check_models(const std::vector<MaterialParameters<double>> &materials)
+    {
+      for (const MaterialParameters<double> &m : materials)
+        AssertThrow(m.model != MaterialModel::user_defined,
+                    dealii::ExcMessage("Parameter 'Backend/Backend': 'cuda' cannot run a constitutive model defined "
+                                       "outside the library (UserConstitutiveModel); use 'cpu'."));
+    }
+  } // namespace
+#endif
+
+#ifndef MPM_CUDA_ENGINE
+  namespace
+  {
+    dealii::ExcMessage not_built()
+    {
+      return dealii::ExcMessage("Parameter 'Backend/Backend': 'cuda' is not available in this build (allowed here: "
+                                "cpu). Configure with -DMPM_WITH_CUDA=ON (needs nvcc) for cuda.");
+    }
   } // namespace
 #endif
 
@@ -101,11 +271,16 @@ namespace mpm
 #endif
   }
 
-  std::future<void> start_cuda_initialisation()
+  std::future<void> start_cuda_initialisation(const MPI_Comm communicator)
   {
 #ifdef MPM_CUDA_ENGINE
-    return std::async(std::launch::async, [] { cuda::initialise_device(); });
+    const int local_rank = node_local_rank(communicator);
+    return std::async(std::launch::async, [local_rank] {
+      cuda::use_device_of_local_rank(local_rank);
+      cuda::initialise_device();
+    });
 #else
+    (void)communicator;
     std::promise<void> nothing_to_do;
     nothing_to_do.set_value();
     return nothing_to_do.get_future();
@@ -118,23 +293,51 @@ namespace mpm
                                                 const ShapeFunction shape)
   {
 #ifdef MPM_CUDA_ENGINE
-    for (const MaterialParameters<double> &m : materials)
-      AssertThrow(m.model != MaterialModel::user_defined,
-                  dealii::ExcMessage("Parameter 'Backend/Backend': 'cuda' cannot run a constitutive model defined "
-                                     "outside the library (UserConstitutiveModel); use 'cpu'."));
-    std::string why;
-    AssertThrow(cuda::device_count(&why) > 0,
-                dealii::ExcMessage("Parameter 'Backend/Backend': 'cuda' was asked for, but no CUDA device is usable (" +
-                                   why + "). Use 'cpu', or run on a machine with an NVIDIA GPU and driver."));
+    check_models(materials);
+    check_device(MPI_COMM_SELF);
+    cuda::use_device_of_local_rank(0);
     std::cout << "  CUDA device: " << cuda::device_description() << std::endl; // one rank
     return std::make_unique<CudaEngine<dim>>(lattice, materials, shape);
 #else
     (void)lattice;
     (void)materials;
     (void)shape;
-    AssertThrow(false, dealii::ExcMessage("Parameter 'Backend/Backend': 'cuda' is not available in this build "
-                                          "(allowed here: cpu). Configure with -DMPM_WITH_CUDA=ON (needs nvcc) "
-                                          "for cuda."));
+    AssertThrow(false, not_built());
+    return nullptr;
+#endif
+  }
+
+  template <int dim>
+  std::unique_ptr<Engine<dim>> make_cuda_engine(BackgroundGrid<dim> &grid,
+                                                const std::vector<MaterialParameters<double>> &materials,
+                                                const ShapeFunction shape)
+  {
+#ifdef MPM_CUDA_ENGINE
+    check_models(materials);
+    check_device(grid.communicator);
+    const int device = cuda::use_device_of_local_rank(node_local_rank(grid.communicator));
+    // One line per rank, printed by rank 0: which GPU each rank drives, and how the
+    // ghost exchange travels.
+    const std::vector<std::string> devices = dealii::Utilities::MPI::gather(
+      grid.communicator, "GPU " + std::to_string(device) + ", " + cuda::device_description(), 0);
+    const std::size_t staged = grid.exchanged_local_nodes().size() * sizeof(double);
+    const std::vector<std::size_t> bytes = dealii::Utilities::MPI::gather(grid.communicator, staged, 0);
+    if (dealii::Utilities::MPI::this_mpi_process(grid.communicator) == 0)
+      {
+        for (std::size_t r = 0; r < devices.size(); ++r)
+          std::cout << "  CUDA device of rank " << r << ": " << devices[r] << std::endl;
+        std::cout << "  ghost-node exchange staged through pinned host memory ("
+                  << (mpi_is_cuda_aware() ? "the MPI is CUDA-aware, but device buffers are not passed to it yet" :
+                                            "the MPI is not CUDA-aware")
+                  << "): " << *std::max_element(bytes.begin(), bytes.end())
+                  << " bytes per array each way on the busiest rank, at the start" << std::endl;
+      }
+    return std::make_unique<CudaEngine<dim>>(grid, materials, shape);
+#else
+    (void)grid;
+    (void)materials;
+    (void)shape;
+    AssertThrow(false, not_built());
     return nullptr;
 #endif
   }
@@ -142,5 +345,9 @@ namespace mpm
   template std::unique_ptr<Engine<2>> make_cuda_engine(const HostGrid<2, double> &,
                                                        const std::vector<MaterialParameters<double>> &, ShapeFunction);
   template std::unique_ptr<Engine<3>> make_cuda_engine(const HostGrid<3, double> &,
+                                                       const std::vector<MaterialParameters<double>> &, ShapeFunction);
+  template std::unique_ptr<Engine<2>> make_cuda_engine(BackgroundGrid<2> &,
+                                                       const std::vector<MaterialParameters<double>> &, ShapeFunction);
+  template std::unique_ptr<Engine<3>> make_cuda_engine(BackgroundGrid<3> &,
                                                        const std::vector<MaterialParameters<double>> &, ShapeFunction);
 } // namespace mpm

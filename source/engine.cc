@@ -132,15 +132,12 @@ namespace mpm
     };
   } // namespace
 
-  void check_backend(const std::string &backend, const unsigned int n_ranks)
+  void check_backend(const std::string &backend)
   {
     AssertThrow(backend == "cpu" || (backend == "cuda" && cuda_engine_built()),
                 dealii::ExcMessage("Parameter 'Backend/Backend': '" + backend +
                                    "' is not available in this build (allowed here: cpu). Build with "
                                    "-DMPM_WITH_CUDA=ON for cuda."));
-    AssertThrow(backend == "cpu" || n_ranks == 1,
-                dealii::ExcMessage("Parameter 'Backend/Backend': 'cuda' runs on one MPI rank only for now "
-                                   "(allowed on " + std::to_string(n_ranks) + " ranks: cpu)."));
   }
 
   template <int dim>
@@ -148,7 +145,7 @@ namespace mpm
                                            const std::vector<MaterialParameters<double>> &materials,
                                            const ShapeFunction shape)
   {
-    check_backend(backend, 1);
+    check_backend(backend);
     if (backend == "cuda")
       return make_cuda_engine<dim>(lattice, materials, shape); // throws where no device is found
     return std::make_unique<CpuEngine<dim>>(lattice, materials, shape);
@@ -159,8 +156,9 @@ namespace mpm
                                            const std::vector<MaterialParameters<double>> &materials,
                                            const ShapeFunction shape)
   {
-    check_backend(backend, grid.n_ranks);
-    AssertThrow(backend == "cpu", dealii::ExcMessage("Internal: the CUDA engine runs on its own lattice nodes."));
+    check_backend(backend);
+    if (backend == "cuda")
+      return make_cuda_engine<dim>(grid, materials, shape); // throws where a rank finds no device
     return std::make_unique<CpuEngine<dim>>(grid, materials, shape);
   }
 

@@ -599,13 +599,13 @@ namespace mpm
                                      dealii::Utilities::to_string(parameters.fixed_time_step) +
                                      " s exceeds the elastic stability limit h / c_el = " +
                                      dealii::Utilities::to_string(s.h / s.c_el) + " s (CFL > 1)."));
-    check_backend(parameters.backend, s.n_ranks); // before any set-up
+    check_backend(parameters.backend); // before any set-up
 
     // Set-up. The CUDA context is created on a thread of its own (0.3-0.5 s on the GPU
     // host) and the bodies' points on another (they need the lattice only).
     std::future<void> cuda_ready;
     if (parameters.backend == "cuda")
-      cuda_ready = start_cuda_initialisation();
+      cuda_ready = start_cuda_initialisation(s.communicator);
     std::shared_future<std::vector<GeneratedBody<dim>>> generation;
     if (given_bodies != nullptr)
       {
@@ -696,6 +696,8 @@ namespace mpm
       {
         s.timer.enter_subsection("setup: engine");
         s.balance();
+        if (cuda_ready.valid())
+          cuda_ready.get();
         s.engine = make_engine<dim>(parameters.backend, *s.grid, s.materials, parameters.shape_function);
         s.engine->set_sort_interval(parameters.sort_interval);
         s.engine->load(*s.points);

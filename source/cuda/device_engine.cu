@@ -4,6 +4,7 @@
 #include <mpm/core/backend/cuda_backend.h>
 #include <mpm/core/backend/cuda_point_order.h>
 #include <mpm/core/backend/cuda_storage.h>
+#include <mpm/core/migration.h>
 #include <mpm/cuda/device_engine.h>
 
 #include <algorithm>
@@ -51,19 +52,125 @@ namespace mpm
       return text;
     }
 
+    int use_device_of_local_rank(const int node_local_rank)
+    {
+      const int n = device_count();
+      if (n == 0)
+        return 0; // the engine's constructor reports it
+      const int device = node_local_rank % n;
+      MPM_CUDA_CHECK(cudaSetDevice(device));
+      return device;
+    }
+
     namespace
     {
-      // The step's exchange hook: nothing on one rank, the NodalExchange otherwise.
+      // Pack and unpack of the exchanged entries: values[k * n + j] = arrays[k][index[j]].
+      constexpr int max_exchanged_arrays = 8;
+      struct ArrayList
+      {
+        double *array[max_exchanged_arrays];
+      };
+      template <typename Index>
+      __global__ void pack_kernel(const long n, const int count, const Index *index, const ArrayList arrays,
+                                  double *values)
+      {
+        const long j = blockIdx.x * static_cast<long>(blockDim.x) + threadIdx.x;
+        if (j >= n * count)
+          return;
+        values[j] = arrays.array[j / n][index[j % n]];
+      }
+      template <typename Index>
+      __global__ void unpack_kernel(const long n, const int count, const Index *index, const double *values,
+                                    const ArrayList arrays)
+      {
+        const long j = blockIdx.x * static_cast<long>(blockDim.x) + threadIdx.x;
+        if (j >= n * count)
+          return;
+        arrays.array[j / n][index[j % n]] = values[j];
+      }
+
+      // One kind of exchanged entries (nodes or cells): their indices on the device, the
+      // packed values on the device and in pinned host memory.
+      template <typename Index>
+      struct Staging
+      {
+        DeviceArray<Index>  index;
+        DeviceArray<double> packed;
+        double             *host   = nullptr;
+        std::size_t         host_n = 0;
+
+        Staging()                = default;
+        Staging(const Staging &) = delete;
+        ~Staging() { cudaFreeHost(host); }
+
+        void set_index(const std::vector<Index> &i) { index.upload(i); }
+
+        // Packs count arrays, hands the host copy to sum (which replaces it by the sums over
+        // the ranks), unpacks; in the stream's order, the host waits for the pack only.
+        template <typename Sum>
+        void exchange(CudaBackend &backend, double *const *arrays, const int count, Sum &&sum)
+        {
+          if (count > max_exchanged_arrays)
+            throw std::logic_error("DeviceEngine: too many arrays in one exchange");
+          const long n     = static_cast<long>(index.size());
+          const long total = n * count;
+          ArrayList  list{};
+          for (int k = 0; k < count; ++k)
+            list.array[k] = arrays[k];
+          if (packed.size() < static_cast<std::size_t>(total))
+            packed.resize(total);
+          if (host_n < static_cast<std::size_t>(total))
+            {
+              cudaFreeHost(host);
+              host = nullptr;
+              MPM_CUDA_CHECK(cudaMallocHost(&host, total * sizeof(double)));
+              host_n = total;
+            }
+          const cudaStream_t stream  = backend.get_stream();
+          const int          threads = 256;
+          const long         blocks  = (total + threads - 1) / threads;
+          if (total > 0)
+            {
+              pack_kernel<Index><<<blocks, threads, 0, stream>>>(n, count, index.data(), list, packed.data());
+              MPM_CUDA_CHECK_LAUNCH();
+              MPM_CUDA_CHECK(
+                cudaMemcpyAsync(host, packed.data(), total * sizeof(double), cudaMemcpyDeviceToHost, stream));
+            }
+          MPM_CUDA_CHECK(cudaStreamSynchronize(stream));
+          sum(host, count); // collective: every rank calls it, with or without entries
+          if (total > 0)
+            {
+              MPM_CUDA_CHECK(
+                cudaMemcpyAsync(packed.data(), host, total * sizeof(double), cudaMemcpyHostToDevice, stream));
+              unpack_kernel<Index><<<blocks, threads, 0, stream>>>(n, count, index.data(), packed.data(), list);
+              MPM_CUDA_CHECK_LAUNCH();
+            }
+        }
+      };
+
+      // The step's exchange hook: nothing on one rank, the NodalExchange through the
+      // staging buffers otherwise.
       struct ExchangeAdapter
       {
-        NodalExchange *exchange;
-        int            n_nodes;
+        NodalExchange   *exchange = nullptr;
+        CudaBackend     *backend  = nullptr;
+        Staging<int>    *nodes    = nullptr;
+        Staging<long>   *cells    = nullptr;
         template <typename Real>
         void sum_nodal(Real *const *arrays, const int count) const
         {
           static_assert(std::is_same<Real, double>::value, "the engine runs in double");
           if (exchange != nullptr)
-            exchange->sum_nodal(arrays, count, n_nodes);
+            nodes->exchange(*backend, arrays, count,
+                            [this](double *values, const int c) { exchange->sum_nodal(values, c); });
+        }
+        template <typename Real>
+        void sum_cells(Real *const *arrays, const int count) const
+        {
+          static_assert(std::is_same<Real, double>::value, "the engine runs in double");
+          if (exchange != nullptr)
+            cells->exchange(*backend, arrays, count,
+                            [this](double *values, const int c) { exchange->sum_cells(values, c); });
         }
       };
 
@@ -102,7 +209,10 @@ namespace mpm
       DeviceArray<double>          cell_volume, cell_pressure_volume;
       long                         n_lattice_cells = 1;
       ShapeFunction                shape;
+      Staging<int>                 exchanged_nodes;
+      Staging<long>                exchanged_cells;
       ExchangeAdapter              exchange;
+      DeviceArray<long>            home_cells; // several ranks: in upload order
       // The device numbers its nodes in lattice order (one rank, the host's nodes being the
       // whole lattice); otherwise as the host does.
       bool                         lattice_order = false;
@@ -184,7 +294,12 @@ namespace mpm
         }
       impl->grid.upload(host);
       impl->materials.upload(materials);
-      impl->exchange = ExchangeAdapter{exchange, g.n_nodes};
+      impl->exchange = ExchangeAdapter{exchange, &impl->backend, &impl->exchanged_nodes, &impl->exchanged_cells};
+      if (exchange != nullptr)
+        {
+          impl->exchanged_nodes.set_index(exchange->exchanged_nodes());
+          impl->exchanged_cells.set_index(exchange->exchanged_cells());
+        }
     }
 
     template <int dim>
@@ -195,6 +310,7 @@ namespace mpm
     {
       impl->points.upload(p);
       impl->order.reset(impl->backend, impl->points.size());
+      impl->home_cells.resize(0); // set_home_cells gives those of these points
       impl->steps_since_upload = 0;
       impl->averaging_pending  = false; // the host's stresses are final
     }
@@ -311,6 +427,34 @@ namespace mpm
     {
       impl->backend.synchronize(); // the table may be in use by a launch in flight
       impl->materials.upload(materials);
+    }
+
+    template <int dim>
+    void DeviceEngine<dim>::set_home_cells(const std::vector<long> &home_cells)
+    {
+      if (static_cast<int>(home_cells.size()) != impl->points.size())
+        throw std::invalid_argument("DeviceEngine::set_home_cells: one home cell per uploaded point is needed");
+      impl->home_cells.upload(home_cells);
+    }
+
+    template <int dim>
+    double DeviceEngine<dim>::max_distance_outside_home_cells()
+    {
+      const int n = impl->points.size();
+      if (static_cast<int>(impl->home_cells.size()) != n)
+        throw std::logic_error("DeviceEngine: the home cells of the uploaded points are not known");
+      const PointsView<dim, double> p        = impl->points.view();
+      const GridView<dim, double>   g        = impl->grid.view();
+      const long                   *home     = impl->home_cells.data();
+      const int                    *original = impl->order.original_index(); // slot -> upload order
+      return impl->backend.reduce_points(
+        n, 0.0,
+        [=] MPM_HOST_DEVICE(const int i) {
+          return p.material[i] < 0 ? 0.0 :
+                                     distance_outside_home_cell<dim>(g.origin, g.h, g.n_cells, p.position,
+                                                                     home[original[i]], i);
+        },
+        [] MPM_HOST_DEVICE(const double a, const double b) { return a > b ? a : b; });
     }
 
     template <int dim>

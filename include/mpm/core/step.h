@@ -798,12 +798,14 @@ namespace mpm
                                     const Exchange &exchange = Exchange(), bool *averaging_pending = nullptr)
   {
     using namespace stages;
-    Real *mass_and_momentum[dim + 1], *momentum[dim], *forces[dim];
-    mass_and_momentum[0] = g.mass;
+    // The arrays summed over ranks after each P2G (MPI): after the first, mass, momentum
+    // and force in one exchange (one round of messages, and on the GPU one staging).
+    Real *mass_and_momentum[dim + 1], *momentum[dim], *forces[dim], *p2g_sums[2 * dim + 1];
+    mass_and_momentum[0] = p2g_sums[0] = g.mass;
     for (int d = 0; d < dim; ++d)
       {
-        mass_and_momentum[d + 1] = momentum[d] = g.momentum[d];
-        forces[d]                              = g.force[d];
+        mass_and_momentum[d + 1] = momentum[d] = p2g_sums[d + 1] = g.momentum[d];
+        forces[d] = p2g_sums[dim + 1 + d] = g.force[d];
       }
 
     // The last step's averaging, deferred to this step's P2G (MUSL, USL).
@@ -842,8 +844,7 @@ namespace mpm
 #endif
             reset_grid(backend, g, true, s.pressure_averaging && !apply_pending);
             particles_to_grid<dim, Shape>(backend, g, p, s, true, true, stencils, apply_pending);
-            exchange.sum_nodal(mass_and_momentum, dim + 1);
-            exchange.sum_nodal(forces, dim);
+            exchange.sum_nodal(p2g_sums, 2 * dim + 1);
             update_grid(backend, g, s, dt, true, apply_pending);
             grid_to_particle_velocity_and_remap<dim, Shape>(backend, g, p, s, stencils);
             exchange.sum_nodal(momentum, dim);
@@ -858,8 +859,7 @@ namespace mpm
         case UpdateScheme::usl:
           reset_grid(backend, g, true, s.pressure_averaging && !apply_pending);
           particles_to_grid<dim, Shape>(backend, g, p, s, true, true, nullptr, apply_pending);
-          exchange.sum_nodal(mass_and_momentum, dim + 1);
-          exchange.sum_nodal(forces, dim);
+          exchange.sum_nodal(p2g_sums, 2 * dim + 1);
           update_grid(backend, g, s, dt, false, apply_pending);
           grid_to_particle_velocity<dim, Shape>(backend, g, p, s);
           grid_to_particle_kinematics<dim, Shape>(backend, g, p, materials, s, dt, true, true, nullptr,

@@ -3,7 +3,8 @@
 // here. The implementation (source/cuda/device_engine.cu, compiled by nvcc into the
 // static library mpm_cuda_engine) keeps the points and nodes in device memory for
 // the whole run; data crosses to the host only in upload/download (output, end of
-// run, later MPI migration) and as the few bytes of each step's reduction.
+// run, MPI migration), as the few bytes of each step's reduction and, on several MPI
+// ranks, as the ghost entries of the nodal exchange.
 //
 // The host grid description is a GridView<dim, double> whose geometry, lattice
 // lookup (lattice_to_node) and boundary masks (fixed_components) are read once at
@@ -37,14 +38,28 @@ namespace mpm
     // Name, compute capability and memory of the current device, for the log.
     std::string device_description();
 
-    // Where ranks will sum their ghost-node contributions on device buffers, between
-    // a P2G pass and the nodal update (the MPI engineer's hook). The arrays are device
-    // pointers, each n_nodes long, laid out as the host grid's node numbering.
+    // Node-local rank -> device: the rank's GPU is (node-local rank) modulo the number of
+    // devices; makes it the current device of the calling thread (every thread that uses
+    // the engine, and the one that creates the context, must call it). Returns the device.
+    int use_device_of_local_rank(int node_local_rank);
+
+    // Where ranks sum their ghost contributions (several MPI ranks; null on one). The device
+    // packs the entries that the exchange touches (ghost nodes and the owned nodes that
+    // other ranks hold as ghosts) into pinned host memory, the host side sums them over the
+    // ranks there (deal.II's Partitioner import/export), the device unpacks the sums. Only
+    // those entries cross the PCIe bus, not the whole nodal arrays.
     class NodalExchange
     {
     public:
-      virtual ~NodalExchange()                                                        = default;
-      virtual void sum_nodal(double *const *device_arrays, int count, int n_nodes) = 0;
+      virtual ~NodalExchange() = default;
+      // Node indices (the host grid's numbering) that sum_nodal reads and writes.
+      virtual std::vector<int> exchanged_nodes() const = 0;
+      // values[k * n + j] is array k at exchanged_nodes()[j] (n of them); on return, the
+      // sums over the ranks.
+      virtual void sum_nodal(double *values, int count) = 0;
+      // The same for the pressure averaging's cell arrays, indexed by lattice cell.
+      virtual std::vector<long> exchanged_cells() const = 0;
+      virtual void              sum_cells(double *values, int count) = 0;
     };
 
     template <int dim>
@@ -79,6 +94,12 @@ namespace mpm
       StepReduction<double> step(const StepSettings<dim, double> &settings, double dt);
       PointTotals<dim, double> totals();
       void set_materials(const std::vector<MaterialParameters<double>> &materials);
+
+      // Several ranks: the lattice cell each point was sorted into when it was uploaded
+      // (in upload order), and the largest distance of a point outside it, in cell units
+      // (core/migration.h), reduced on the device.
+      void   set_home_cells(const std::vector<long> &home_cells);
+      double max_distance_outside_home_cells();
 
       int n_points() const;
 

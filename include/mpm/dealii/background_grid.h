@@ -85,6 +85,17 @@ namespace mpm
     // Bytes one rank sends per array in one sum_nodal (import + export of its ghosts).
     std::size_t exchange_bytes_per_array() const;
 
+    // For an engine whose arrays live elsewhere (the GPU) and come to the host only for the
+    // exchange. Nodes: the local indices that sum_nodal reads or writes (every ghost node and
+    // the owned nodes that other ranks hold as ghosts), ascending. Cells: the same in the cell
+    // partitioner's local numbering, and the lattice cell of each local cell.
+    std::vector<unsigned int> exchanged_local_nodes() const;
+    std::vector<unsigned int> exchanged_local_cells() const;
+    long lattice_cell_of_local_cell(unsigned int local_cell) const { return lattice_cell_of_local_cell_index[local_cell]; }
+    // sum_cells on arrays laid out as the cell partitioner's local storage (owned, then ghosts).
+    template <typename Real>
+    void sum_local_cells(Real *const *arrays, int count) const;
+
     MPI_Comm                                  communicator;
     unsigned int                              n_ranks;
     // p4est on several ranks. On one rank a serial Triangulation: the same cells in the same
@@ -131,7 +142,7 @@ namespace mpm
                       int count) const;
 
     // Lattice cell index of each owned and ghost cell, in the cell partitioner's local order.
-    std::vector<long> lattice_cell_of_local_cell;
+    std::vector<long> lattice_cell_of_local_cell_index;
 
     std::array<BoundaryType, 6> boundary;
     std::vector<int>          lattice_to_node;

@@ -7,7 +7,7 @@
 // from the generated bodies: it needs neither deal.II's grid nor the handler, which are
 // built beside the first steps. On several ranks the nodes are the BackgroundGrid's
 // ghosted vectors, summed over ranks after each scatter. CPU here; the CUDA engine
-// (cuda_engine.h) implements the same interface over device arrays, on one rank.
+// (cuda_engine.h) implements the same interface over device arrays, one GPU per rank.
 #pragma once
 
 #include <mpm/core/diagnostics.h>
@@ -52,9 +52,9 @@ namespace mpm
     virtual void set_materials(const std::vector<MaterialParameters<double>> &materials) = 0;
   };
 
-  // Throws naming Backend/Backend where the backend cannot run here: not in this build, or
-  // cuda on more than one rank. The simulator asks before any set-up.
-  void check_backend(const std::string &backend, unsigned int n_ranks);
+  // Throws naming Backend/Backend where the backend is not in this build. The simulator
+  // asks before any set-up.
+  void check_backend(const std::string &backend);
 
   // One rank: the engine's own nodes on the lattice (lattice_grid: geometry and boundary
   // masks). Throws naming Backend/Backend if the requested backend is not available.
@@ -63,7 +63,8 @@ namespace mpm
                                            const std::vector<MaterialParameters<double>> &materials,
                                            ShapeFunction shape);
 
-  // Several ranks: the nodes are the grid's vectors (cpu only for now).
+  // Several ranks: the nodes are the grid's (cpu: its vectors; cuda: the device's copy of
+  // the rank's locally relevant nodes, exchanged through the grid's partitioner).
   template <int dim>
   std::unique_ptr<Engine<dim>> make_engine(const std::string &backend, BackgroundGrid<dim> &grid,
                                            const std::vector<MaterialParameters<double>> &materials,

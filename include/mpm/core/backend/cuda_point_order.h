@@ -156,6 +156,9 @@ namespace mpm
       });
     }
 
+    // For each slot, the index its point had at the last reset() (the upload order).
+    const int *original_index() const { return original.data(); }
+
   private:
     DeviceArray<int>  keys, sorted_keys, identity, permutation, original, int_scratch;
     DeviceArray<Real> real_scratch;

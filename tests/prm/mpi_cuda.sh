@@ -1,0 +1,27 @@
+#!/bin/bash
+# Backend = cuda on 1, 2 and 4 MPI ranks (one GPU per rank; ranks beyond a node's GPUs
+# share them). The scenes and assertions of the CPU's MPI tests: the reduced 2D V3 collapse
+# (mpi_collapse.sh) and the 3D collapse with pressure averaging (mpi_collapse_3d.sh), final
+# positions and stresses np-invariant to 1e-10 of the field's magnitude, points migrating
+# and the grid repartitioned on 4 ranks. Then the 3D scene on 2 ranks, cuda against cpu,
+# per point to the same 1e-10 (no local damping: round-off stays round-off).
+# Exits 77 (ctest: skipped) where no CUDA device is found.
+# Usage: mpi_cuda.sh EXE SOURCE_DIR OUTDIR
+set -eu
+exe=$1 src=$2 out=$3 here=$(dirname "$0")
+if ! nvidia-smi -L >/dev/null 2>&1; then
+  echo "no CUDA device: skipped"
+  exit 77
+fi
+cuda=("subsection Backend" "  set Backend = cuda" "end")
+echo "== 2D collapse, cuda, 1 2 4 ranks"
+bash "$here/mpi_collapse.sh" "$exe" "$src" "$out/collapse-2d" "${cuda[@]}"
+echo "== 3D collapse with pressure averaging, cuda, 1 2 4 ranks"
+bash "$here/mpi_collapse_3d.sh" "$exe" "$src" "$out/collapse-3d" "${cuda[@]}"
+echo "== 3D collapse on 2 ranks: cpu against cuda"
+bash "$here/run_np.sh" "$exe" "$src/prm/granular_collapse_3d.prm" "$out/collapse-3d-cpu" "2" \
+  "subsection Grid" "  set Cell size = 0.01" "end" \
+  "subsection Solver" "  set End time = 0.1" "  set Local damping = 0" "  set Pressure averaging = true" "end" \
+  "subsection Output" "  set Output interval = 0.05" "  set Files per rank = 3" "end" \
+  "subsection Parallel" "  set Load balance threshold = 1.02" "end"
+/usr/bin/python3 "$here/compare_np.py" "$out/collapse-3d-cpu/np2" "$out/collapse-3d/np2" --rtol 1e-10
