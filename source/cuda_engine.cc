@@ -16,6 +16,7 @@
 
 #  include <algorithm>
 #  include <iostream>
+#  include <map>
 #endif
 
 namespace mpm
@@ -125,7 +126,90 @@ namespace mpm
         load(host, std::move(new_labels));
         if (shared_grid != nullptr)
           device->set_home_cells(home_cells);
+        handler_behind = false;
       }
+
+      // The re-sort on the device: only the points that now lie in another rank's cell
+      // come down, travel (deal.II's some_to_some, to the owner of their ghost cell) and go
+      // up on their new rank; the handler is left behind until sync().
+      unsigned int resort(MaterialPoints<dim> &p) override
+      {
+        if (shared_grid == nullptr)
+          return store(p);
+        HostPoints<dim, double> leaving;
+        std::vector<int>        leaving_index, kept_index;
+        const int               dropped = device->take_leaving_points(leaving, leaving_index, kept_index);
+
+        const unsigned int this_rank = dealii::Utilities::MPI::this_mpi_process(shared_grid->communicator);
+        const int          n_values  = values_per_point(leaving);
+        std::map<unsigned int, std::vector<double>> outgoing;
+        for (int k = 0; k < leaving.size(); ++k)
+          {
+            double x[dim];
+            for (int d = 0; d < dim; ++d)
+              x[d] = leaving.position[d][k];
+            const int owner = owner_of_cell[shared_grid->lattice_cell_of(x)];
+            AssertThrow(owner >= 0 && owner != static_cast<int>(this_rank),
+                        dealii::ExcMessage("Internal: a point moved beyond the ghost cells of its rank between "
+                                           "two re-sorts (Parallel/Re-sort distance)."));
+            std::vector<double> &to = outgoing[owner];
+            for_each_point_array<dim>(leaving, leaving, [&](const auto &array, const auto &) {
+              to.push_back(static_cast<double>(array[k]));
+            });
+            to.push_back(static_cast<double>(labels->id[leaving_index[k]]));
+            for (int d = 0; d < dim; ++d)
+              to.push_back(labels->initial_position[d][leaving_index[k]]);
+          }
+        const std::map<unsigned int, std::vector<double>> incoming =
+          dealii::Utilities::MPI::some_to_some(shared_grid->communicator, outgoing);
+
+        // The new upload order: the points that stayed, then those received, by rank.
+        auto new_labels                  = std::make_shared<PointLabels<dim>>();
+        new_labels->state_variable_names = labels->state_variable_names;
+        for (const int i : kept_index)
+          {
+            new_labels->id.push_back(labels->id[i]);
+            for (int d = 0; d < dim; ++d)
+              new_labels->initial_position[d].push_back(labels->initial_position[d][i]);
+          }
+        int n_received = 0;
+        for (const auto &from : incoming)
+          n_received += static_cast<int>(from.second.size()) / (n_values + 1 + dim);
+        HostPoints<dim, double> received;
+        received.set_n_state_variables(leaving.n_state_variables());
+        received.resize(n_received);
+        int k = 0;
+        for (const auto &from : incoming)
+          for (std::size_t at = 0; at < from.second.size(); ++k)
+            {
+              for_each_point_array<dim>(received, received, [&](auto &array, auto &) {
+                using T  = typename std::decay_t<decltype(array)>::value_type;
+                array[k] = static_cast<T>(from.second[at++]);
+              });
+              new_labels->id.push_back(static_cast<dealii::types::particle_index>(from.second[at++]));
+              for (int d = 0; d < dim; ++d)
+                new_labels->initial_position[d].push_back(from.second[at++]);
+            }
+        device->append_points(received);
+        labels = std::move(new_labels);
+        p.n_sent += leaving.size();
+        handler_behind = true;
+        return static_cast<unsigned int>(dropped);
+      }
+
+      // The handler gets the device's points (each rank's are in its own cells), and the
+      // device takes them back in the handler's order.
+      void sync(MaterialPoints<dim> &p) override
+      {
+        if (!handler_behind)
+          return;
+        PointSnapshot<dim> now;
+        snapshot(now);
+        p.replace(now);
+        load(p);
+      }
+
+      long n_points() const override { return device->n_points(); }
 
       void load(const HostPoints<dim, double> &p, std::shared_ptr<const PointLabels<dim>> new_labels) override
       {
@@ -196,6 +280,17 @@ namespace mpm
       HostPoints<dim, double>                 host;       // staging for load/store from the handler only
       std::vector<long>                       home_cells; // several ranks: lattice cell of each point at load
       std::shared_ptr<const PointLabels<dim>> labels;     // id, initial position, in the uploaded order
+      // Several ranks: the owner of each owned or ghost lattice cell (-1 elsewhere), and
+      // whether resort() has moved points since the handler last saw them.
+      std::vector<int> owner_of_cell;
+      bool             handler_behind = false;
+
+      static int values_per_point(HostPoints<dim, double> &points)
+      {
+        int n = 0;
+        for_each_point_array<dim>(points, points, [&](const auto &, const auto &) { ++n; });
+        return n;
+      }
 
       void build_on_grid()
       {
@@ -205,6 +300,20 @@ namespace mpm
         device    = std::make_unique<cuda::DeviceEngine<dim>>(shared_grid->view(), materials, shape, exchange.get());
         if (sort_interval >= 0)
           device->set_sort_interval(sort_interval);
+        long n_lattice_cells = 1;
+        for (int d = 0; d < dim; ++d)
+          n_lattice_cells *= shared_grid->n_cells[d];
+        owner_of_cell.assign(n_lattice_cells, -1);
+        std::vector<std::uint8_t> owned(n_lattice_cells, 0);
+        for (const auto &cell : shared_grid->triangulation.active_cell_iterators())
+          if (cell->is_locally_owned() || cell->is_ghost())
+            {
+              const dealii::Point<dim> centre = cell->center();
+              const long               c      = shared_grid->lattice_cell_of(&centre[0]);
+              owner_of_cell[c]                = static_cast<int>(cell->subdomain_id());
+              owned[c]                        = cell->is_locally_owned() ? 1 : 0;
+            }
+        device->set_owned_cells(owned);
       }
     };
 

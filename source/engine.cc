@@ -116,6 +116,8 @@ namespace mpm
 
       PointTotals<dim, double> totals() override { return point_totals<dim>(backend, points.view()); }
 
+      long n_points() const override { return points.size(); }
+
       void set_materials(const std::vector<MaterialParameters<double>> &m) override { materials = m; }
 
     private:

@@ -539,10 +539,16 @@ namespace mpm
   template <int dim>
   double MaterialPoints<dim>::imbalance() const
   {
+    return imbalance(static_cast<double>(handler.n_locally_owned_particles()));
+  }
+
+  template <int dim>
+  double MaterialPoints<dim>::imbalance(const double n_local_points) const
+  {
     // The work model of the partition's cell weights: cells plus weighted points.
     const double local = (grid.distributed ? grid.distributed->n_locally_owned_active_cells() :
                                              grid.triangulation.n_active_cells()) +
-                         point_weight * static_cast<double>(handler.n_locally_owned_particles());
+                         point_weight * n_local_points;
     const double most  = dealii::Utilities::MPI::max(local, grid.communicator);
     const double total = dealii::Utilities::MPI::sum(local, grid.communicator);
     return total > 0 ? most * grid.n_ranks / total : 1.0;

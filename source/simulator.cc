@@ -162,6 +162,12 @@ namespace mpm
         }
     }
 
+    // Max/mean work per rank; the engine knows its points where it re-sorts them itself.
+    double imbalance() const
+    {
+      return engine ? points->imbalance(static_cast<double>(engine->n_points())) : points->imbalance();
+    }
+
     // Repartition when the work per rank is out of balance by more than the threshold and
     // by clearly more than the last repartition could reach (no futile repeats when the
     // granularity of cells forbids better). Points per rank only change at re-sorts, so
@@ -170,12 +176,14 @@ namespace mpm
     {
       if (!parallel || !(parameters.load_balance_threshold > 0))
         return false;
-      const double before = points->imbalance();
+      const double before = imbalance();
       if (before <= parameters.load_balance_threshold ||
           before <= balanced + 0.5 * (parameters.load_balance_threshold - 1))
         return false;
       dealii::TimerOutput::Scope scope(timer, "repartition");
       output->finish(); // a grid output in flight reads the DoFHandler
+      if (engine)
+        engine->sync(*points); // the handler's points move with their cells
       points->repartition();
       ++n_repartitions;
       balanced = points->imbalance();
@@ -231,7 +239,7 @@ namespace mpm
             {
               {
                 dealii::TimerOutput::Scope scope(timer, "migrate points");
-                engine->store(*points);
+                engine->resort(*points);
                 ++n_resorts;
               }
               if (balance())
@@ -831,7 +839,7 @@ namespace mpm
       {
         s.pcout << "  MPI: " << s.n_resorts << " re-sorts of the points into cells and ranks, "
                 << static_cast<long>(sum(double(s.points->n_sent), s.communicator)) << " points migrated, "
-                << s.n_repartitions << " repartitions; work per rank max/mean " << s.points->imbalance() << "\n";
+                << s.n_repartitions << " repartitions; work per rank max/mean " << s.imbalance() << "\n";
         // Ghost exchange per step: import + export of every ghost node's value, for each
         // array the scheme sums (MUSL: mass, momentum, force, then momentum again).
         const double ghosts = s.grid->partitioner->n_ghost_indices();

@@ -148,6 +148,53 @@ namespace mpm
         }
       };
 
+      // to[k] = from[slot[k]], k < m: the points at the given slots, in that order.
+      template <typename T>
+      __global__ void gather_slots_kernel(const int m, const int *slot, const T *from, T *to)
+      {
+        const int k = static_cast<int>(blockIdx.x * blockDim.x + threadIdx.x);
+        if (k < m)
+          to[k] = from[slot[k]];
+      }
+
+      // Every point array replaced by (keep) or copied to the host as (take) its entries at
+      // the slots, in the slots' order.
+      template <int dim>
+      void keep_slots(DevicePoints<dim, double> &points, const DeviceArray<int> &slots, const cudaStream_t stream)
+      {
+        const int m = static_cast<int>(slots.size());
+        for_each_point_array<dim>(points, points, [&](auto &array, auto &) {
+          using T = typename std::decay_t<decltype(array)>::value_type;
+          DeviceArray<T> kept(m);
+          if (m > 0)
+            {
+              gather_slots_kernel<T><<<(m + 255) / 256, 256, 0, stream>>>(m, slots.data(), array.data(), kept.data());
+              MPM_CUDA_CHECK_LAUNCH();
+            }
+          MPM_CUDA_CHECK(cudaStreamSynchronize(stream)); // before the old array is freed
+          array.swap(kept);
+        });
+      }
+      template <int dim>
+      void take_slots(const DevicePoints<dim, double> &points, const DeviceArray<int> &slots,
+                      HostPoints<dim, double> &host, const cudaStream_t stream)
+      {
+        const int m = static_cast<int>(slots.size());
+        host.set_n_state_variables(0); // the device runs the library's models, which have none
+        host.resize(m);
+        for_each_point_array<dim>(points, host, [&](const auto &array, auto &to) {
+          using T = typename std::decay_t<decltype(array)>::value_type;
+          DeviceArray<T> taken(m);
+          if (m > 0)
+            {
+              gather_slots_kernel<T><<<(m + 255) / 256, 256, 0, stream>>>(m, slots.data(), array.data(), taken.data());
+              MPM_CUDA_CHECK_LAUNCH();
+            }
+          MPM_CUDA_CHECK(cudaStreamSynchronize(stream));
+          taken.download(to);
+        });
+      }
+
       // The step's exchange hook: nothing on one rank, the NodalExchange through the
       // staging buffers otherwise.
       struct ExchangeAdapter
@@ -213,6 +260,7 @@ namespace mpm
       Staging<long>                exchanged_cells;
       ExchangeAdapter              exchange;
       DeviceArray<long>            home_cells; // several ranks: in upload order
+      DeviceArray<std::uint8_t>    owned_cells; // several ranks: 1 for each lattice cell this rank owns
       // The device numbers its nodes in lattice order (one rank, the host's nodes being the
       // whole lattice); otherwise as the host does.
       bool                         lattice_order = false;
@@ -455,6 +503,120 @@ namespace mpm
                                                                      home[original[i]], i);
         },
         [] MPM_HOST_DEVICE(const double a, const double b) { return a > b ? a : b; });
+    }
+
+    template <int dim>
+    void DeviceEngine<dim>::set_owned_cells(const std::vector<std::uint8_t> &owned)
+    {
+      if (static_cast<long>(owned.size()) != impl->n_lattice_cells)
+        throw std::invalid_argument("DeviceEngine::set_owned_cells: one entry per lattice cell is needed");
+      impl->owned_cells.upload(owned);
+    }
+
+    template <int dim>
+    int DeviceEngine<dim>::take_leaving_points(HostPoints<dim, double> &leaving, std::vector<int> &leaving_index,
+                                               std::vector<int> &kept_index)
+    {
+      if (static_cast<long>(impl->owned_cells.size()) != impl->n_lattice_cells)
+        throw std::logic_error("DeviceEngine::take_leaving_points: the owned cells are not known");
+      if (impl->averaging_pending)
+        {
+          stages::finish_pressure_averaging(impl->backend, impl->view(), impl->points.view());
+          impl->averaging_pending = false;
+        }
+      const int n = impl->points.size();
+      // Per slot: 0 stays, 1 leaves for another rank, 2 left the grid.
+      DeviceArray<std::uint8_t>     status(n);
+      const PointsView<dim, double> p     = impl->points.view();
+      const GridView<dim, double>   g     = impl->grid.view();
+      const std::uint8_t           *owned = impl->owned_cells.data();
+      std::uint8_t                 *out   = status.data();
+      impl->backend.for_each_node(n, [=] MPM_HOST_DEVICE(const int i) {
+        if (p.material[i] < 0)
+          {
+            out[i] = 2;
+            return;
+          }
+        long cell = 0;
+        for (int d = dim - 1; d >= 0; --d)
+          {
+            long c = static_cast<long>(floor((p.position[d][i] - g.origin[d]) / g.h));
+            c      = c < 0 ? 0 : (c >= g.n_cells[d] ? g.n_cells[d] - 1 : c);
+            cell   = cell * g.n_cells[d] + c;
+          }
+        out[i] = owned[cell] ? 0 : 1;
+      });
+      impl->backend.synchronize();
+      std::vector<std::uint8_t> host_status;
+      status.download(host_status);
+      std::vector<int> original(n);
+      if (n > 0)
+        MPM_CUDA_CHECK(cudaMemcpy(original.data(), impl->order.original_index(), n * sizeof(int),
+                                  cudaMemcpyDeviceToHost));
+      std::vector<int> kept_slots, leaving_slots;
+      kept_index.clear();
+      leaving_index.clear();
+      int n_dropped = 0;
+      for (int i = 0; i < n; ++i)
+        if (host_status[i] == 0)
+          {
+            kept_slots.push_back(i);
+            kept_index.push_back(original[i]);
+          }
+        else if (host_status[i] == 1)
+          {
+            leaving_slots.push_back(i);
+            leaving_index.push_back(original[i]);
+          }
+        else
+          ++n_dropped;
+      DeviceArray<int> slots;
+      slots.upload(leaving_slots);
+      take_slots<dim>(impl->points, slots, leaving, impl->backend.get_stream());
+      slots.upload(kept_slots);
+      keep_slots<dim>(impl->points, slots, impl->backend.get_stream());
+      impl->home_cells.resize(0); // append_points sets them
+      return n_dropped;
+    }
+
+    template <int dim>
+    void DeviceEngine<dim>::append_points(const HostPoints<dim, double> &added)
+    {
+      const int          m      = impl->points.size();
+      const int          r      = added.size();
+      const cudaStream_t stream = impl->backend.get_stream();
+      if (added.n_state_variables() != 0)
+        throw std::invalid_argument("DeviceEngine::append_points: the device holds no state variables");
+      for_each_point_array<dim>(impl->points, added, [&](auto &array, const auto &tail) {
+        using T = typename std::decay_t<decltype(array)>::value_type;
+        DeviceArray<T> longer(m + r);
+        if (m > 0)
+          MPM_CUDA_CHECK(cudaMemcpyAsync(longer.data(), array.data(), m * sizeof(T), cudaMemcpyDeviceToDevice, stream));
+        if (r > 0)
+          MPM_CUDA_CHECK(
+            cudaMemcpyAsync(longer.data() + m, tail.data(), r * sizeof(T), cudaMemcpyHostToDevice, stream));
+        MPM_CUDA_CHECK(cudaStreamSynchronize(stream));
+        array.swap(longer);
+      });
+      // The new upload order, and every point at home in its current cell.
+      const int n = m + r;
+      impl->order.reset(impl->backend, n);
+      impl->steps_since_upload = 0; // sorted by stencil at the next step
+      impl->averaging_pending  = false;
+      impl->home_cells.resize(n);
+      const PointsView<dim, double> p    = impl->points.view();
+      const GridView<dim, double>   g    = impl->grid.view();
+      long                         *home = impl->home_cells.data();
+      impl->backend.for_each_node(n, [=] MPM_HOST_DEVICE(const int i) {
+        long cell = 0;
+        for (int d = dim - 1; d >= 0; --d)
+          {
+            long c = static_cast<long>(floor((p.position[d][i] - g.origin[d]) / g.h));
+            c      = c < 0 ? 0 : (c >= g.n_cells[d] ? g.n_cells[d] - 1 : c);
+            cell   = cell * g.n_cells[d] + c;
+          }
+        home[i] = cell;
+      });
     }
 
     template <int dim>

@@ -13,6 +13,7 @@ if ! nvidia-smi -L >/dev/null 2>&1; then
   echo "no CUDA device: skipped"
   exit 77
 fi
+mkdir -p "$out"
 cuda=("subsection Backend" "  set Backend = cuda" "end")
 echo "== 2D collapse, cuda, 1 2 4 ranks"
 bash "$here/mpi_collapse.sh" "$exe" "$src" "$out/collapse-2d" "${cuda[@]}"

@@ -18,6 +18,7 @@
 #include <mpm/core/step.h>
 #include <mpm/core/views.h>
 
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
@@ -100,6 +101,20 @@ namespace mpm
       // (core/migration.h), reduced on the device.
       void   set_home_cells(const std::vector<long> &home_cells);
       double max_distance_outside_home_cells();
+
+      // Several ranks: the MPI re-sort on the device, where only the points that change
+      // rank cross the bus. set_owned_cells: 1 for each lattice cell this rank owns (once
+      // per partition). take_leaving_points applies a pending pressure averaging, then
+      // splits the points by their current cell: those in other ranks' cells come down
+      // into `leaving` (leaving_index: their upload-order index), those that left the grid
+      // are dropped (the count is returned), the others stay in their current order
+      // (kept_index: upload-order index of each). append_points adds the points received
+      // from other ranks at the end. After it, the device's order is the new upload order
+      // and every point's home cell is its current cell.
+      void set_owned_cells(const std::vector<std::uint8_t> &owned);
+      int  take_leaving_points(HostPoints<dim, double> &leaving, std::vector<int> &leaving_index,
+                               std::vector<int> &kept_index);
+      void append_points(const HostPoints<dim, double> &points);
 
       int n_points() const;
 

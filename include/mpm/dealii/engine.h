@@ -31,6 +31,18 @@ namespace mpm
     // Points given as arrays, with their labels in the same order (points_of_bodies).
     virtual void load(const HostPoints<dim, double> &points, std::shared_ptr<const PointLabels<dim>> labels) = 0;
     virtual unsigned int            store(MaterialPoints<dim> &points)                = 0;
+    // The MPI re-sort: points that have moved into other ranks' cells go there, points
+    // that left the grid are removed (their number on this rank is returned), and every
+    // point's home cell becomes its current cell. By default through the handler (store);
+    // an engine may move only the points that change rank and leave the handler behind
+    // until sync().
+    virtual unsigned int resort(MaterialPoints<dim> &points) { return store(points); }
+    // Brings the handler up to date with the engine's points where resort() left it behind
+    // (before a repartition, which moves the handler's points with their cells).
+    virtual void sync(MaterialPoints<dim> & /*points*/) {}
+    // Points the engine holds on this rank (those that left the grid may be counted until
+    // the next re-sort).
+    virtual long n_points() const = 0;
     virtual StepReduction<double>   step(const StepSettings<dim, double> &s, double dt) = 0;
     virtual PointTotals<dim, double> totals()                                         = 0;
     // For output: copies the points as they are now into snapshot.points (engine order,

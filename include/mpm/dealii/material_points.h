@@ -135,6 +135,9 @@ namespace mpm
     // Largest work of one rank over the mean (1 = perfectly balanced), work being the
     // partition's weights: owned cells + Point weight x owned points.
     double imbalance() const;
+    // The same with this rank's number of points given (an engine that re-sorts without
+    // the handler knows it; the handler's count is then out of date).
+    double imbalance(double n_local_points) const;
 
     // Repartitions the triangulation by work (cell weight 1 + Point weight x points in
     // the cell), moves the points with their cells, and rebuilds the grid's nodes.

@@ -24,6 +24,7 @@ namespace mpm
   class DeviceArray
   {
   public:
+    using value_type = T;
     DeviceArray() = default;
     explicit DeviceArray(const size_t n) { resize(n); }
     DeviceArray(const DeviceArray &)            = delete;
