@@ -37,7 +37,8 @@ for np in 1 2; do
   rc=$?
   t1=$(date +%s.%N)
   echo "P2 np $np: rc $rc, $(awk "BEGIN{print $t1 - $t0}") s wall (shell clock) | $(grep -E 'done, t =' "$d.log")"
-  grep -E "CUDA device of rank|ghost-node exchange|re-sorts|repartition" "$d.log" | head -6
+  grep -E "CUDA device of rank|ghost-node exchange|re-sorts|repartition|set-up" "$d.log" | head -8
+  grep -A16 "Total wallclock" "$d.log" | grep -E "MPM step|migrate|repartition|output|history|setup|Total" | head -12
 done
 
 # P1: strong scaling at each size, then weak scaling (twice the width on 2 ranks)

@@ -5,7 +5,6 @@ import math
 import os
 import xml.etree.ElementTree as ET
 
-import meshio
 import numpy as np
 
 
@@ -17,6 +16,7 @@ def pvd_records(output_dir, name="particles"):
 
 def read_pvtu(output_dir, pvtu):
     """Points and point data of all pieces of one .pvtu file, merged."""
+    import meshio  # only here: the particle tables and histories need numpy alone
     root = ET.parse(os.path.join(output_dir, pvtu)).getroot()
     pieces = [p.get("Source") for p in root.iter("Piece")]
     points, data = [], {}

@@ -95,6 +95,7 @@ namespace mpm
     dealii::ConditionalOStream pcout;
     dealii::TimerOutput        timer;
     const std::chrono::steady_clock::time_point wall_start;
+    std::chrono::steady_clock::time_point       stepping_start; // the end of setup()
 
     double c_el = 0, h = 0;
     std::unique_ptr<BackgroundGrid<dim>> grid;
@@ -744,6 +745,7 @@ namespace mpm
     s.record_history();
     if (!grid_beside_first_steps)
       s.join_grid();
+    s.stepping_start = std::chrono::steady_clock::now();
   }
 
   template <int dim>
@@ -832,9 +834,13 @@ namespace mpm
     const KeepPrecision keep(std::cout);
     const double wall  = std::chrono::duration<double>(std::chrono::steady_clock::now() - s.wall_start).count();
     const double n_now = static_cast<double>(s.n_points_initial - s.n_removed);
+    const double stepping =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - s.stepping_start).count();
     s.pcout << "dealii-mpm: done, t = " << s.time << " s after " << s.step << " steps in " << wall << " s wall ("
             << std::setprecision(3) << (n_now * s.step) / wall << " point-updates/s); " << s.n_removed
-            << " material point(s) left the grid and were removed.\n";
+            << " material point(s) left the grid and were removed.\n"
+            << "  set-up " << wall - stepping << " s, then " << stepping << " s of steps and output ("
+            << (n_now * s.step) / stepping << " point-updates/s)\n";
     if (s.parallel)
       {
         s.pcout << "  MPI: " << s.n_resorts << " re-sorts of the points into cells and ranks, "

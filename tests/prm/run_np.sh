@@ -12,5 +12,5 @@ for np in $nps; do
     "subsection Output" "  set Write particle table = true" "end" "$@" > "$out-np$np.log" 2>&1 ||
     { cat "$out-np$np.log"; echo "FAILED: the run on $np rank(s) failed"; exit 1; }
   grep -E "^  (MPI|repartitioned)" "$out-np$np.log" | sed "s/^/np $np:/" || true
-  echo "np $np: $(echo "$(date +%s.%N) - $start" | bc) s wall"
+  echo "np $np: $(awk "BEGIN{print $(date +%s.%N) - $start}") s wall"
 done
