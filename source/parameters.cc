@@ -314,7 +314,8 @@ namespace mpm
     prm.enter_subsection("Backend");
     prm.declare_entry("Backend", "cpu", Patterns::Selection("cpu|cuda"),
                       "Where the MPM step runs: cpu (threads through TBB) or cuda (needs a build with "
-                      "-DMPM_WITH_CUDA=ON and a CUDA device; one MPI rank for now).");
+                      "-DMPM_WITH_CUDA=ON and a CUDA device on every rank; on several MPI ranks one GPU per "
+                      "rank, chosen by the rank's place on its node, ranks beyond a node's GPUs sharing them).");
     prm.declare_entry("Sort interval", "20", Patterns::Integer(0),
                       "cuda: the device re-sorts its points by stencil every this many steps (0: never), so "
                       "that neighbouring threads add into the same nodes and sum before their atomics. 20 "
