@@ -1,5 +1,6 @@
 // dealii-mpm: explicit material point method for large deformation of soils.
 //   dealii-mpm scene.prm              run a scene
+//   dealii-mpm scene.prm --resume DIR continue it from a checkpoint
 //   dealii-mpm --print-parameters [2|3] [prm|description|json]
 //   dealii-mpm --help
 #include <mpm/dealii/parameters.h>
@@ -8,6 +9,7 @@
 
 #include <deal.II/base/mpi.h>
 
+#include <csignal>
 #include <cstdlib>
 #include <iostream>
 #include <string>
@@ -21,9 +23,34 @@ namespace
            "Usage:\n"
            "  dealii-mpm scene.prm                 run the scene described by a parameter file\n"
            "  mpirun -np N dealii-mpm scene.prm    the same on N MPI ranks\n"
+           "  dealii-mpm scene.prm --resume DIR    continue the scene from a checkpoint: DIR is one\n"
+           "                                       (checkpoint-NNNNNNNNN) or the folder holding them\n"
+           "                                       (Checkpoint/Directory; the newest is taken), on any\n"
+           "                                       number of ranks\n"
            "  dealii-mpm --print-parameters [2|3] [prm|description|json]\n"
            "                                       print every parameter with its default and documentation\n"
-           "  dealii-mpm --help                    this text\n";
+           "  dealii-mpm --help                    this text\n"
+           "SIGTERM or SIGINT (Ctrl-C) during the steps: a checkpoint is written after the current step and\n"
+           "the run stops with exit status 75; a second signal stops it at once.\n";
+  }
+
+  // The exit status of a run stopped by SIGTERM/SIGINT after writing its checkpoint
+  // (sysexits.h's EX_TEMPFAIL: try again, here with --resume).
+  constexpr int exit_stopped = 75;
+
+  // The first signal asks for a checkpoint and a stop after the current step; a second
+  // one (an impatient Ctrl-C) ends the process at once, as without this handler.
+  extern "C" void stop_after_checkpoint(const int signal)
+  {
+    static volatile std::sig_atomic_t received = 0;
+    if (received)
+      {
+        std::signal(signal, SIG_DFL);
+        std::raise(signal);
+        return;
+      }
+    received = 1;
+    mpm::request_checkpoint_and_stop();
   }
 } // namespace
 
@@ -57,17 +84,44 @@ int main(int argc, char **argv)
             mpm::print_parameters(std::cout, dim, argc > 3 ? argv[3] : "prm");
           return 0;
         }
-      if (argc != 2 || first.empty() || first[0] == '-')
+      // scene.prm, or scene.prm --resume DIR (either order).
+      std::string prm, resume;
+      bool        well_formed = argc == 2 || argc == 4;
+      for (int a = 1; a < argc && well_formed; ++a)
+        {
+          const std::string arg = argv[a];
+          if (arg == "--resume" && a + 1 < argc && resume.empty())
+            resume = argv[++a];
+          else if (!arg.empty() && arg[0] != '-' && prm.empty())
+            prm = arg;
+          else
+            well_formed = false;
+        }
+      if (!well_formed || prm.empty() || (argc == 4 && resume.empty()))
         {
           if (root)
             print_help(std::cerr);
           return 2;
         }
-      const mpm::Parameters parameters = mpm::read_parameters(first);
+      const mpm::Parameters parameters = mpm::read_parameters(prm);
       if (parameters.prefailure.analysis != mpm::fem::Analysis::none)
-        mpm::fem::run_prefailure_analysis(parameters, MPI_COMM_WORLD);
+        {
+          AssertThrow(resume.empty(), dealii::ExcMessage("--resume: a pre-failure analysis (Pre-failure analysis/"
+                                                         "Analysis) has no checkpoints; resume the MPM run instead."));
+          mpm::fem::run_prefailure_analysis(parameters, MPI_COMM_WORLD);
+        }
       else
-        mpm::run_simulation(parameters, MPI_COMM_WORLD);
+        {
+          std::signal(SIGTERM, stop_after_checkpoint);
+          std::signal(SIGINT, stop_after_checkpoint);
+          if (!mpm::run_simulation(parameters, MPI_COMM_WORLD, resume))
+            {
+              if (root)
+                std::cout << "  continue with: dealii-mpm " << prm << " --resume "
+                          << parameters.checkpoint_directory << std::endl;
+              return exit_stopped;
+            }
+        }
     }
   catch (const dealii::ExceptionBase &e)
     {

@@ -44,6 +44,9 @@ namespace mpm
         auto new_labels = std::make_shared<PointLabels<dim>>();
         p.copy_to(points, &home_cells, new_labels.get());
         labels = std::move(new_labels); // a snapshot being written keeps the old ones
+        // New points: the scatter's slabs are built anew for them, as in a new engine (a
+        // run resumed from a checkpoint then sums in the order of the run that wrote it).
+        backend.forget_grouping();
       }
 
       void load(const HostPoints<dim, double> &p, std::shared_ptr<const PointLabels<dim>> new_labels) override
@@ -51,6 +54,7 @@ namespace mpm
         points = p;
         home_cells.clear(); // asked for on several ranks only, which load from the handler
         labels = std::move(new_labels);
+        backend.forget_grouping();
       }
 
       unsigned int store(MaterialPoints<dim> &p) override

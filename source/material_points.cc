@@ -8,6 +8,7 @@
 #include <cmath>
 #include <map>
 #include <memory>
+#include <sstream>
 
 namespace mpm
 {
@@ -137,6 +138,106 @@ namespace mpm
         }
       return weight;
     }
+
+    // A random field whose standard deviation is large against its mean puts many points
+    // below zero; raised to the floor, they shift the field's mean and distribution.
+    void check_clipped_fraction(const Parameters &p, const unsigned int m, const long n_clipped, const long n)
+    {
+      const double fraction = n > 0 ? double(n_clipped) / n : 0;
+      if (fraction <= p.material_field_max_clipped[m])
+        return;
+      const RandomFieldParameters &rf    = p.material_fields[m];
+      const bool                   angle = p.materials[m].field_parameter == FieldParameter::friction_angle;
+      const double                 unit  = angle ? 180 / M_PI : 1; // prm units: degrees, Pa
+      const std::string            where = "Material " + p.material_names[m] + "/Random field/";
+      std::ostringstream           what;
+      what.precision(3);
+      what << 100 * fraction << "% of the material's points (" << n_clipped << " of " << n
+           << ") drew a value below 1e-3 of the mean (" << rf.mean * unit << (angle ? " deg" : " Pa")
+           << ") and would be raised to that floor, more than Maximum clipped fraction = "
+           << 100 * p.material_field_max_clipped[m] << "%: the field's mean and spread would not be those given. "
+           << "Standard deviation " << rf.standard_deviation * unit << " is " << rf.standard_deviation / rf.mean
+           << " times the mean; below about mean / 2.33 (" << rf.mean * unit / 2.33
+           << ") at most 1% of a Gaussian lies below zero. Reduce the standard deviation, or raise Maximum "
+              "clipped fraction (0..1) if the floor is meant.";
+      AssertThrow(false, dealii::ExcMessage("Parameter '" + where + "Standard deviation': " + what.str()));
+    }
+
+    // Whether x lies inside the body, by more than `margin` (points on a shared face are in
+    // neither of two bodies that touch).
+    template <int dim>
+    bool inside_body(const BodyParameters &body, const double *x, const double margin)
+    {
+      const int first = body.shape == "polygon" ? 1 : 0; // a polygon's x and vertical come from its vertices
+      for (int d = first; d < (body.shape == "polygon" ? dim - 1 : dim); ++d)
+        if (!(x[d] > body.lower[d] + margin && x[d] < body.upper[d] - margin))
+          return false;
+      if (body.shape == "cylinder")
+        return std::hypot(x[0] - body.axis[0], x[1] - body.axis[1]) < body.radius - margin;
+      if (body.shape != "polygon")
+        return true;
+      std::vector<double> px, pv;
+      for (const auto &v : body.polygon)
+        {
+          px.push_back(v[0]);
+          pv.push_back(v[1]);
+        }
+      if (!inside_polygon(px, pv, x[0], x[dim - 1]))
+        return false;
+      for (std::size_t i = 0, j = px.size() - 1; i < px.size(); j = i++) // not on an edge
+        {
+          const double ex = px[i] - px[j], ev = pv[i] - pv[j];
+          const double t  = std::clamp(((x[0] - px[j]) * ex + (x[dim - 1] - pv[j]) * ev) /
+                                        std::max(ex * ex + ev * ev, 1e-300), 0.0, 1.0);
+          if (std::hypot(x[0] - px[j] - t * ex, x[dim - 1] - pv[j] - t * ev) <= margin)
+            return false;
+        }
+      return true;
+    }
+
+    // Bodies must not overlap: the points of both would be kept, the overlap's mass counted
+    // twice (and its geostatic weight). Refused naming both bodies.
+    template <int dim>
+    void check_no_overlap(const Parameters &p, const std::vector<GeneratedBody<dim>> &bodies)
+    {
+      const double margin = 1e-9 * p.cell_size;
+      for (unsigned int b = 0; b < bodies.size(); ++b)
+        for (unsigned int other = 0; other < bodies.size(); ++other)
+          {
+            if (other == b)
+              continue;
+            const HostPoints<dim, double> &points = bodies[b].points;
+            long                           n      = 0;
+            double                         mass   = 0;
+            int                            first  = -1;
+            for (int i = 0; i < points.size(); ++i)
+              {
+                double x[dim];
+                for (int d = 0; d < dim; ++d)
+                  x[d] = points.position[d][i];
+                if (inside_body<dim>(p.bodies[other], x, margin))
+                  {
+                    n += 1;
+                    mass += points.mass[i];
+                    first = first < 0 ? i : first;
+                  }
+              }
+            if (n == 0)
+              continue;
+            std::ostringstream what;
+            what.precision(4);
+            what << "Parameter 'Material points/Body " << b + 1 << "': the body overlaps Material points/Body "
+                 << other + 1 << ": " << n << " of its " << points.size() << " points (" << mass
+                 << (dim == 2 ? " kg per m of thickness" : " kg") << ") lie inside Body " << other + 1
+                 << ", the first at (";
+            for (int d = 0; d < dim; ++d)
+              what << (d ? ", " : "") << points.position[d][first];
+            what << "). Overlapping bodies are refused: the points of both would be kept and the overlap's "
+                    "mass counted twice. Give each region to one body only (a polygon can follow the other "
+                    "body's outline; bodies may touch).";
+            AssertThrow(false, dealii::ExcMessage(what.str()));
+          }
+    }
   } // namespace
 
   template <int dim>
@@ -162,6 +263,7 @@ namespace mpm
         }
 
     std::vector<GeneratedBody<dim>> bodies(parameters.bodies.size());
+    std::map<unsigned int, std::pair<long, long>> clipped; // material -> (points raised to the floor, points)
     for (unsigned int b = 0; b < parameters.bodies.size(); ++b)
       {
         const BodyParameters &body = parameters.bodies[b];
@@ -226,10 +328,17 @@ namespace mpm
                   xa[d] = x[d];
                 // A Gaussian field can go below zero: cohesion and modulus are kept positive.
                 const double v           = field->second->value(xa);
-                points.material_field[i] = std::max(v, 1e-3 * std::abs(parameters.material_fields[field->first].mean));
+                const double floor       = 1e-3 * std::abs(parameters.material_fields[field->first].mean);
+                points.material_field[i] = std::max(v, floor);
+                clipped[field->first].first += v < floor;
+                clipped[field->first].second += 1;
               }
           }
       }
+    // Every rank generates every body: the checks find the same on every rank.
+    for (const auto &[m, count] : clipped)
+      check_clipped_fraction(parameters, m, count.first, count.second);
+    check_no_overlap<dim>(parameters, bodies);
     return bodies;
   }
 

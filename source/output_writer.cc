@@ -245,7 +245,7 @@ namespace mpm
   }
 
   template <int dim>
-  OutputWriter<dim>::OutputWriter(const Parameters &parameters, MPI_Comm communicator)
+  OutputWriter<dim>::OutputWriter(const Parameters &parameters, MPI_Comm communicator, const bool resuming)
     : communicator(communicator)
     , rank(dealii::Utilities::MPI::this_mpi_process(communicator))
     , n_ranks(dealii::Utilities::MPI::n_mpi_processes(communicator))
@@ -274,6 +274,11 @@ namespace mpm
           problem = "cannot create '" + output_directory + "': " + error.message();
         else
           {
+            // A resumed run continues the rows of the stopped one (resume()): kept aside here.
+            std::error_code ignored;
+            if (resuming)
+              std::filesystem::rename(output_directory + "/history.csv", output_directory + "/history.csv.stopped",
+                                      ignored);
             history.open(output_directory + "/history.csv");
             if (!history)
               problem = "cannot write to '" + output_directory + "'.";
@@ -294,6 +299,34 @@ namespace mpm
         history << ",min_points_per_rank,max_points_per_rank,n_resorts,n_repartitions,n_sent";
         history << "\n" << std::setprecision(16);
       }
+  }
+
+  template <int dim>
+  void OutputWriter<dim>::resume(const Records &records, const long step)
+  {
+    counter          = records.n_outputs;
+    grid_records     = records.grid;
+    particle_records = records.particles;
+    if (rank != 0)
+      return;
+    // The rows of the run so far, from the file of the stopped run (where there is one: the
+    // output folder may be a new one), up to the checkpoint's step.
+    const std::string  file = output_directory + "/history.csv";
+    std::ifstream      old(file + ".stopped");
+    std::string        line;
+    std::getline(old, line); // the header, written anew by the constructor
+    while (std::getline(old, line))
+      {
+        std::istringstream fields(line);
+        std::string        time, dt, row_step;
+        if (std::getline(fields, time, ',') && std::getline(fields, dt, ',') && std::getline(fields, row_step, ',') &&
+            std::stol(row_step) <= step)
+          history << line << '\n';
+      }
+    history.flush();
+    old.close();
+    std::error_code error;
+    std::filesystem::remove(file + ".stopped", error);
   }
 
   template <int dim>

@@ -1,3 +1,4 @@
+#include <mpm/dealii/guards.h>
 #include <mpm/dealii/material_library.h>
 #include <mpm/dealii/parameters.h>
 
@@ -153,6 +154,12 @@ namespace mpm
                       "summed over ranks.");
     prm.declare_entry("Maximum number of steps", "0", Patterns::Integer(0),
                       "Stop after this many steps even before End time; 0 = no limit.");
+    prm.declare_entry("Maximum predicted steps", "1e9", Patterns::Double(0),
+                      "A run whose first time step predicts more steps than this to End time (End time / dt, dt "
+                      "from the CFL number, Grid/Cell size and the elastic wave speed of the bodies' Young's "
+                      "modulus, Poisson's ratio and Density, or the Fixed time step; at most Maximum number of "
+                      "steps) is refused before it starts: it would not end (a mistyped exponent?). 0 = no limit "
+                      "(doc/guards.md).");
     prm.leave_subsection();
 
     prm.enter_subsection("Materials");
@@ -180,6 +187,11 @@ namespace mpm
         prm.declare_entry("Standard deviation", "0", Patterns::Double(0),
                           "Standard deviation s, in the parameter's prm unit (Pa, degrees).");
         prm.declare_entry("Seed", "1", Patterns::Integer(0), "Seed of the random numbers (same seed, same field).");
+        prm.declare_entry("Maximum clipped fraction", "0.01", Patterns::Double(0, 1),
+                          "A Gaussian field can fall below zero: values below 1e-3 of the mean are raised to that "
+                          "floor, which shifts the field's mean and distribution. The run is refused when more than "
+                          "this fraction of the material's points are raised (a standard deviation large against "
+                          "the mean: 1% of a Gaussian lies below mean - 2.33 standard deviations).");
         prm.leave_subsection();
         prm.leave_subsection();
       }
@@ -248,6 +260,27 @@ namespace mpm
                       "Each rank writes its grid cells and its points as this many .vtu pieces per output (the "
                       ".pvtu record lists them all), built, compressed and written on as many threads: more than "
                       "1 speeds up the output of large scenes on many cores.");
+    prm.declare_entry("Maximum number of outputs", "10000", Patterns::Integer(0),
+                      "Warn (and run on) where Output interval and Solver/End time give more outputs than this "
+                      "(each one .vtu files per rank and a .pvtu record for the grid and the points); 0 = no "
+                      "warning.");
+    prm.leave_subsection();
+
+    prm.enter_subsection("Checkpoint");
+    prm.declare_entry("Step interval", "0", Patterns::Integer(0),
+                      "Steps between checkpoints (the whole state of the run, from which --resume continues it "
+                      "exactly); 0 = none by step count.");
+    prm.declare_entry("Wall-clock interval", "0", Patterns::Double(0),
+                      "Wall-clock minutes between checkpoints; 0 = none by wall-clock time. On several ranks the "
+                      "rank whose clock is first due decides for all.");
+    prm.declare_entry("Number kept", "2", Patterns::Integer(1),
+                      "Newest checkpoints kept in the folder; older ones are deleted once a newer one is complete.");
+    prm.declare_entry("Directory", "", Patterns::DirectoryName(),
+                      "Folder of the checkpoints (one sub-folder checkpoint-NNNNNNNNN per checkpoint, NNNNNNNNN its "
+                      "step); empty = the folder 'checkpoints' in Output/Directory.");
+    prm.declare_entry("At end", "false", Patterns::Bool(),
+                      "Also write a checkpoint when the run ends, so that it can be continued to a later End time "
+                      "(dealii-mpm scene.prm --resume FOLDER with the End time raised).");
     prm.leave_subsection();
 
     prm.enter_subsection("Parallel");
@@ -322,6 +355,15 @@ namespace mpm
                       "measured faster than 50 and than every step on P1; 10, 20 and 40 alike on P2 "
                       "(doc/performance.md).");
     prm.leave_subsection();
+
+    prm.enter_subsection("Resources");
+    prm.declare_entry("Memory limit", "0", Patterns::Double(0),
+                      "Memory (GB, 1e9 bytes) the whole run may take, all ranks together. The run's memory is "
+                      "estimated from the prm (grid cells, material points from the bodies' volumes and point "
+                      "spacing, random fields) before anything is allocated, and the run is refused, naming the "
+                      "entry that needs the most, where the estimate exceeds this limit. 0 = the memory available "
+                      "on each node (MemAvailable of /proc/meminfo) shared by the ranks it holds (doc/guards.md).");
+    prm.leave_subsection();
   }
 
   void Parameters::parse(ParameterHandler &prm)
@@ -391,6 +433,7 @@ namespace mpm
     gravity           = get_point(prm, "Gravity");
     gravity_ramp_time = prm.get_double("Gravity ramp time");
     max_steps         = prm.get_integer("Maximum number of steps");
+    max_predicted_steps = prm.get_double("Maximum predicted steps");
     plasticity_start_time = prm.get_double("Plasticity start time");
     pressure_averaging    = prm.get_bool("Pressure averaging");
     prm.leave_subsection();
@@ -442,6 +485,7 @@ namespace mpm
         rf.correlation_length = get_point(prm, "Correlation lengths");
         rf.standard_deviation = prm.get_double("Standard deviation");
         rf.seed               = prm.get_integer("Seed");
+        material_field_max_clipped.push_back(prm.get_double("Maximum clipped fraction"));
         for (const double L : rf.correlation_length)
           if (!(L > 0))
             fail(where + "Correlation lengths", "every correlation length must be > 0.");
@@ -625,6 +669,17 @@ namespace mpm
     output_compression   = prm.get("Compression");
     output_in_background = prm.get_bool("Write in background");
     output_files_per_rank = prm.get_integer("Files per rank");
+    max_outputs           = prm.get_integer("Maximum number of outputs");
+    prm.leave_subsection();
+
+    prm.enter_subsection("Checkpoint");
+    checkpoint_step_interval = prm.get_integer("Step interval");
+    checkpoint_wall_interval = prm.get_double("Wall-clock interval");
+    checkpoint_keep          = prm.get_integer("Number kept");
+    checkpoint_directory     = prm.get("Directory");
+    checkpoint_at_end        = prm.get_bool("At end");
+    if (checkpoint_directory.empty())
+      checkpoint_directory = (output_directory.empty() ? std::string(".") : output_directory) + "/checkpoints";
     prm.leave_subsection();
 
     prm.enter_subsection("Parallel");
@@ -646,6 +701,11 @@ namespace mpm
           fail("Backend/Backend", "cuda cannot run material '" + material_names[i] + "': its model '" +
                                     material_models[i] + "' is defined outside the library and runs on the "
                                     "CPU backend only (Backend = cpu).");
+
+    prm.enter_subsection("Resources");
+    memory_limit = prm.get_double("Memory limit");
+    prm.leave_subsection();
+    check_run_size(*this);
   }
 
   std::vector<std::string> Parameters::state_variable_names() const
@@ -710,6 +770,7 @@ namespace mpm
       std::ifstream in(filename);
       AssertThrow(in, ExcMessage("Cannot open the parameter file '" + filename + "'."));
     }
+    check_parameter_file(filename);
     return read_in_two_passes([&](ParameterHandler &prm, const bool skip_undefined) {
       prm.parse_input(filename, "", skip_undefined, /*assert_mandatory_entries_are_found=*/false);
     });
@@ -717,6 +778,7 @@ namespace mpm
 
   Parameters parameters_from_string(const std::string &text)
   {
+    check_parameter_text(text);
     return read_in_two_passes([&](ParameterHandler &prm, const bool skip_undefined) {
       prm.parse_input_from_string(text, "", skip_undefined);
     });

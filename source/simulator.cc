@@ -1,7 +1,9 @@
 #include <mpm/core/migration.h>
 #include <mpm/dealii/background_grid.h>
+#include <mpm/dealii/checkpoint.h>
 #include <mpm/dealii/cuda_engine.h>
 #include <mpm/dealii/fem_state_file.h>
+#include <mpm/dealii/guards.h>
 #include <mpm/dealii/engine.h>
 #include <mpm/dealii/material_points.h>
 #include <mpm/dealii/output_writer.h>
@@ -12,8 +14,10 @@
 #include <deal.II/base/timer.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
+#include <exception>
 #include <future>
 #include <iomanip>
 #include <iostream>
@@ -27,6 +31,10 @@ namespace mpm
 
   namespace
   {
+    // Set by request_checkpoint_and_stop (a signal handler): lock-free, so async-signal-safe.
+    std::atomic<bool> stop_requested{false};
+    static_assert(std::atomic<bool>::is_always_lock_free);
+
     template <int dim>
     PointTotals<dim, double> global_totals(PointTotals<dim, double> t, MPI_Comm comm)
     {
@@ -63,6 +71,21 @@ namespace mpm
         c = std::max(c, std::sqrt(p.materials[p.body_material[b]].elastic.p_wave_modulus() / p.bodies[b].density));
       return c;
     }
+
+    // Deletes the run's TimerOutput, except while an exception unwinds the stack (an error on
+    // its way to the user): there deal.II's destructor skips the timing summary (a collective
+    // MPI call that not every rank might reach) and prints instead its seven-line banner
+    // "TimerOutput objects finalize timed values printed to the screen by communicating over
+    // MPI in their destructors..." ahead of the error's own message. The timer is then left
+    // undestroyed on purpose: it holds no resource but memory, and the error ends the run.
+    struct DeleteTimerUnlessUnwinding
+    {
+      void operator()(dealii::TimerOutput *timer) const
+      {
+        if (std::uncaught_exceptions() == 0)
+          delete timer;
+      }
+    };
   } // namespace
 
   // Everything a run holds between its steps. Members are destroyed in reverse order: the
@@ -77,7 +100,8 @@ namespace mpm
       , n_ranks(dealii::Utilities::MPI::n_mpi_processes(comm))
       , parallel(n_ranks > 1)
       , pcout(std::cout, dealii::Utilities::MPI::this_mpi_process(comm) == 0)
-      , timer(comm, pcout, dealii::TimerOutput::summary, dealii::TimerOutput::wall_times)
+      , timer_owner(new dealii::TimerOutput(comm, pcout, dealii::TimerOutput::summary, dealii::TimerOutput::wall_times))
+      , timer(*timer_owner)
       , wall_start(std::chrono::steady_clock::now())
     {}
 
@@ -93,7 +117,8 @@ namespace mpm
     const unsigned int         n_ranks;
     const bool                 parallel;
     dealii::ConditionalOStream pcout;
-    dealii::TimerOutput        timer;
+    std::unique_ptr<dealii::TimerOutput, DeleteTimerUnlessUnwinding> timer_owner;
+    dealii::TimerOutput                                             &timer;
     const std::chrono::steady_clock::time_point wall_start;
     std::chrono::steady_clock::time_point       stepping_start; // the end of setup()
 
@@ -125,6 +150,29 @@ namespace mpm
     double next_output = 0;
     std::chrono::steady_clock::time_point last_progress;
     bool set_up = false, finished_run = false;
+
+    // Checkpoints: when the last was written (wall clock, step), and what was asked for after
+    // the last step, agreed by every rank: 0 nothing, 1 a checkpoint (wall clock due), 2 a
+    // checkpoint and a stop (request_checkpoint_and_stop).
+    std::chrono::steady_clock::time_point last_checkpoint_wall;
+    long                                  last_checkpoint_step = -1;
+    std::string                           last_checkpoint;
+    int                                   request = 0;
+    bool                                  stopped = false;
+    // Where this process started stepping (a resumed run: the checkpoint's time and step),
+    // for its rates and ETA.
+    double first_time = 0;
+    long   first_step = 0;
+
+    // What this rank asks for after the current step (request): 2 stop, 1 a checkpoint.
+    int local_request() const
+    {
+      if (stop_requested.load())
+        return 2;
+      const double minutes =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - last_checkpoint_wall).count() / 60;
+      return parameters.checkpoint_wall_interval > 0 && minutes >= parameters.checkpoint_wall_interval ? 1 : 0;
+    }
 
     // Reductions over the ranks; on one rank the value itself, without an MPI call.
     double global_max(const double x) const { return parallel ? max(x, communicator) : x; }
@@ -224,12 +272,15 @@ namespace mpm
         {
           // One reduction for the next time step and the migration test: the largest
           // speed and the largest distance of a point outside its home cell.
-          double local[3] = {r.max_speed, engine->max_distance_outside_home_cells(), r.max_removed_speed},
-                 global[3];
-          dealii::Utilities::MPI::max(dealii::ArrayView<const double>(local, 3), communicator,
-                                      dealii::ArrayView<double>(global, 3));
+          // And what the ranks ask for after the step (a checkpoint, a stop).
+          double local[4] = {r.max_speed, engine->max_distance_outside_home_cells(), r.max_removed_speed,
+                             double(local_request())},
+                 global[4];
+          dealii::Utilities::MPI::max(dealii::ArrayView<const double>(local, 4), communicator,
+                                      dealii::ArrayView<double>(global, 4));
           max_speed         = global[0];
           max_removed_speed = global[2];
+          request           = static_cast<int>(global[3]);
           AssertThrow(!parameters.pressure_averaging || global[1] < 1,
                       dealii::ExcMessage("Parameter 'Solver/Pressure averaging': " + when() + " a point moved to " +
                                          dealii::Utilities::to_string(global[1]) +
@@ -376,6 +427,132 @@ namespace mpm
             << equilibration.rms_stress_change << " Pa)" << std::endl;
     }
 
+    // The step's settings from the prm (gravity is set by each step, from the ramp).
+    void apply_settings()
+    {
+      settings.scheme             = parameters.scheme;
+      settings.damping            = parameters.damping;
+      settings.damping_form       = parameters.damping_form;
+      settings.damping_threshold  = parameters.damping_threshold;
+      settings.flip_fraction      = parameters.flip_fraction;
+      settings.domain_update      = parameters.domain_update;
+      settings.pressure_averaging = parameters.pressure_averaging;
+      settings.mass_tolerance     = 1e-12 * m_min; // nodes lighter than that carry no velocity
+    }
+
+    void print_header()
+    {
+      const HostGrid<dim, double> lattice = lattice_geometry<dim>(parameters);
+      long                        n_cells = 1, n_nodes = 1;
+      for (int d = 0; d < dim; ++d)
+        {
+          n_cells *= lattice.n_cells[d];
+          n_nodes *= lattice.n_cells[d] + 1;
+        }
+      pcout << "dealii-mpm: " << dim << "D, " << n_cells << " cells, " << n_nodes << " nodes, " << n_points_initial
+            << " material points, " << n_ranks << " MPI rank(s), backend " << parameters.backend << "\n"
+            << "  elastic wave speed " << c_el << " m/s, end time " << parameters.end_time << " s, output in '"
+            << output->directory() << "'" << std::endl;
+    }
+
+    // Everything of the run but its points and grid, for a checkpoint (collective: the
+    // points handed between ranks are summed).
+    RunState run_state() const
+    {
+      RunState r;
+      r.dim                  = dim;
+      r.n_ranks              = n_ranks;
+      r.lower                = parameters.lower;
+      r.upper                = parameters.upper;
+      r.cell_size            = parameters.cell_size;
+      r.n_materials          = parameters.materials.size();
+      r.state_variable_names = parameters.state_variable_names();
+      r.time                 = time;
+      r.dt                   = dt;
+      r.max_speed            = max_speed;
+      r.max_removed_speed    = max_removed_speed;
+      r.work_of_gravity      = work_of_gravity;
+      r.elastic_wave_speed   = c_el;
+      r.smallest_point_mass  = m_min;
+      r.balanced             = balanced;
+      r.next_output          = next_output;
+      r.step                 = step;
+      r.n_points_initial     = n_points_initial;
+      r.n_removed            = n_removed;
+      r.n_resorts            = n_resorts;
+      r.n_repartitions       = n_repartitions;
+      r.n_sent               = parallel ? static_cast<long>(sum(double(points->n_sent), communicator)) : 0;
+      r.plastic              = plastic;
+      r.equilibration        = equilibration;
+      const auto records     = output->records();
+      r.n_outputs            = records.n_outputs;
+      r.grid_records         = records.grid;
+      r.particle_records     = records.particles;
+      return r;
+    }
+
+    // Several ranks: the partition of the grid by the points' work as it is now (where the
+    // run repartitions at all). A pure function of the points' cells, whichever partition the
+    // grid had before: a run resumed on an even partition comes to the same one.
+    void partition_by_current_work()
+    {
+      if (!parallel || !(parameters.load_balance_threshold > 0))
+        return;
+      output->finish(); // a grid output in flight reads the DoFHandler
+      points->repartition();
+      ++n_repartitions;
+      balanced = points->imbalance();
+    }
+
+    // A checkpoint of the run after the current step. Then the engine starts anew from the
+    // saved points exactly as a run resumed from the checkpoint does (on several ranks: the
+    // handler filled with them, the grid partitioned by their work, the engine loaded from
+    // the handler; on one: the engine loaded with them, forgetting what it built for the
+    // points before, the CPU's scatter slabs): the resumed run is bit-identical to this one.
+    std::string write_checkpoint()
+    {
+      join_grid();
+      dealii::TimerOutput::Scope scope(timer, "checkpoint");
+      const auto                 started = std::chrono::steady_clock::now();
+      PointSnapshot<dim>         snapshot;
+      if (parallel)
+        {
+          engine->resort(*points); // every point on the rank owning its cell
+          ++n_resorts;
+        }
+      engine->snapshot(snapshot);
+      last_checkpoint = checkpoint::write<dim>(parameters.checkpoint_directory, run_state(), snapshot,
+                                               parameters.checkpoint_keep, communicator);
+      start_from(snapshot);
+      last_checkpoint_wall = std::chrono::steady_clock::now();
+      last_checkpoint_step = step;
+      pcout << "  checkpoint at t = " << time << " s (step " << step << "): " << last_checkpoint << " ("
+            << std::chrono::duration<double>(last_checkpoint_wall - started).count() << " s)" << std::endl;
+      return last_checkpoint;
+    }
+
+    // The engine (made where there is none yet) starts from `saved`: a checkpoint's points,
+    // all of this rank's (one rank) or those in its cells (several).
+    void start_from(const PointSnapshot<dim> &saved)
+    {
+      if (parallel)
+        {
+          points->replace(saved);
+          partition_by_current_work();
+          if (!engine)
+            engine = make_engine<dim>(parameters.backend, *grid, materials, parameters.shape_function);
+          engine->load(*points);
+        }
+      else
+        {
+          if (!engine)
+            engine = make_engine<dim>(parameters.backend, lattice_grid<dim>(parameters), materials,
+                                      parameters.shape_function);
+          engine->load(saved.points, saved.labels); // in the saved order: the same sums as before
+        }
+      engine->set_sort_interval(parameters.sort_interval);
+    }
+
     void record_history()
     {
       timed("history", [&]() {
@@ -413,7 +590,9 @@ namespace mpm
   template <int dim>
   Simulator<dim>::Simulator(const Parameters &parameters, MPI_Comm communicator)
     : state(std::make_unique<State>(parameters, communicator))
-  {}
+  {
+    check_memory(parameters, communicator); // before anything large is allocated
+  }
 
   template <int dim>
   Simulator<dim>::~Simulator() = default;
@@ -713,34 +892,16 @@ namespace mpm
         s.timer.leave_subsection();
       }
 
-    const HostGrid<dim, double> lattice = lattice_geometry<dim>(parameters);
-    long                        n_cells = 1, n_nodes = 1;
-    for (int d = 0; d < dim; ++d)
-      {
-        n_cells *= lattice.n_cells[d];
-        n_nodes *= lattice.n_cells[d] + 1;
-      }
-    s.pcout << "dealii-mpm: " << dim << "D, " << n_cells << " cells, " << n_nodes << " nodes, "
-            << s.n_points_initial << " material points, " << s.n_ranks << " MPI rank(s), backend "
-            << parameters.backend << "\n"
-            << "  elastic wave speed " << s.c_el << " m/s, end time " << parameters.end_time
-            << " s, output in '" << s.output->directory() << "'" << std::endl;
-
-    s.settings.scheme             = parameters.scheme;
-    s.settings.damping            = parameters.damping;
-    s.settings.damping_form       = parameters.damping_form;
-    s.settings.damping_threshold  = parameters.damping_threshold;
-    s.settings.flip_fraction      = parameters.flip_fraction;
-    s.settings.domain_update      = parameters.domain_update;
-    s.settings.pressure_averaging = parameters.pressure_averaging;
-    s.settings.mass_tolerance     = 1e-12 * s.m_min; // nodes lighter than that carry no velocity
+    s.print_header();
+    s.apply_settings();
 
     if (parameters.equilibrate)
       s.equilibrate();
 
-    s.next_output   = parameters.output_interval;
-    s.last_progress = std::chrono::steady_clock::now();
-    s.set_up        = true;
+    s.next_output          = parameters.output_interval;
+    s.last_progress        = std::chrono::steady_clock::now();
+    s.last_checkpoint_wall = s.last_progress;
+    s.set_up               = true;
     s.write_output();
     s.record_history();
     if (!grid_beside_first_steps)
@@ -752,7 +913,7 @@ namespace mpm
   bool Simulator<dim>::finished() const
   {
     const State &s = *state;
-    return !(s.time < s.parameters.end_time * (1 - 1e-12) &&
+    return s.stopped || !(s.time < s.parameters.end_time * (1 - 1e-12) &&
              (s.parameters.max_steps == 0 || s.step < long(s.parameters.max_steps)));
   }
 
@@ -793,15 +954,24 @@ namespace mpm
           s.next_output += parameters.output_interval;
       }
 
+    // Checkpoints: every Step interval steps, and where a rank asks (wall clock, a stop).
+    if (!s.parallel)
+      s.request = s.local_request();
+    if ((parameters.checkpoint_step_interval > 0 && s.step % parameters.checkpoint_step_interval == 0) ||
+        s.request > 0)
+      s.write_checkpoint();
+    s.stopped = s.request == 2;
+
     const auto now = std::chrono::steady_clock::now();
     if (parameters.progress_interval > 0 &&
         std::chrono::duration<double>(now - s.last_progress).count() >= parameters.progress_interval)
       {
         const KeepPrecision keep(std::cout);
         const double        elapsed = std::chrono::duration<double>(now - s.wall_start).count();
-        const double eta     = elapsed / s.time * (end - s.time);
+        const double eta     = elapsed / (s.time - s.first_time) * (end - s.time);
         s.pcout << "  t = " << std::setw(10) << s.time << " s  step " << s.step << "  dt " << dt << "  "
-                << std::setprecision(4) << s.step / elapsed << " steps/s  ETA " << eta << " s" << std::endl;
+                << std::setprecision(4) << (s.step - s.first_step) / elapsed << " steps/s  ETA " << eta << " s"
+                << std::endl;
         s.last_progress = now;
       }
     return dt;
@@ -817,6 +987,15 @@ namespace mpm
       return;
     s.finished_run = true;
     s.join_grid(); // a short run may end before the grid thread does
+    if (s.stopped)
+      {
+        dealii::TimerOutput::Scope scope(s.timer, "output");
+        s.output->finish();
+        s.pcout << "dealii-mpm: stopped on request at t = " << s.time << " s after " << s.step
+                << " steps; the run continues from the checkpoint " << s.last_checkpoint << " with --resume"
+                << std::endl;
+        return;
+      }
     if (s.step % parameters.history_every != 0)
       s.record_history();
     const double end = parameters.end_time;
@@ -830,17 +1009,20 @@ namespace mpm
       dealii::TimerOutput::Scope scope(s.timer, "output");
       s.output->finish(); // the last files are complete
     }
+    if (parameters.checkpoint_at_end && s.last_checkpoint_step != s.step)
+      s.write_checkpoint();
 
     const KeepPrecision keep(std::cout);
     const double wall  = std::chrono::duration<double>(std::chrono::steady_clock::now() - s.wall_start).count();
     const double n_now = static_cast<double>(s.n_points_initial - s.n_removed);
+    const long   steps = s.step - s.first_step; // by this process
     const double stepping =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - s.stepping_start).count();
     s.pcout << "dealii-mpm: done, t = " << s.time << " s after " << s.step << " steps in " << wall << " s wall ("
-            << std::setprecision(3) << (n_now * s.step) / wall << " point-updates/s); " << s.n_removed
+            << std::setprecision(3) << (n_now * steps) / wall << " point-updates/s); " << s.n_removed
             << " material point(s) left the grid and were removed.\n"
             << "  set-up " << wall - stepping << " s, then " << stepping << " s of steps and output ("
-            << (n_now * s.step) / stepping << " point-updates/s)\n";
+            << (n_now * steps) / stepping << " point-updates/s)\n";
     if (s.parallel)
       {
         s.pcout << "  MPI: " << s.n_resorts << " re-sorts of the points into cells and ranks, "
@@ -871,6 +1053,123 @@ namespace mpm
     while (!finished())
       advance();
     finish();
+  }
+
+  template <int dim>
+  std::string Simulator<dim>::write_checkpoint()
+  {
+    AssertThrow(state->set_up, dealii::ExcMessage("Simulator::write_checkpoint() needs setup() first."));
+    return state->write_checkpoint();
+  }
+
+  template <int dim>
+  bool Simulator<dim>::stopped() const
+  {
+    return state->stopped;
+  }
+
+  namespace
+  {
+    // A checkpoint resumes the run that wrote it: the same dimension, grid and materials.
+    void check_resumable(const RunState &r, const Parameters &p, const std::string &folder)
+    {
+      const std::string of = "--resume: the checkpoint '" + folder + "' ";
+      AssertThrow(r.dim == p.dim, dealii::ExcMessage(of + "is of a " + std::to_string(r.dim) +
+                                                     "D run; the parameter file's Dimension is " +
+                                                     std::to_string(p.dim) + "."));
+      AssertThrow(r.lower == p.lower && r.upper == p.upper && r.cell_size == p.cell_size,
+                  dealii::ExcMessage(of + "was written on another grid: Grid/Lower corner, Grid/Upper corner and "
+                                          "Grid/Cell size must be those of the run that wrote it."));
+      AssertThrow(r.n_materials == p.materials.size() && r.state_variable_names == p.state_variable_names(),
+                  dealii::ExcMessage(of + "holds points of " + std::to_string(r.n_materials) +
+                                     " material(s); Materials/Names declares " + std::to_string(p.materials.size()) +
+                                     " (the materials, their order and their models must be those of the run that "
+                                     "wrote it)."));
+    }
+  } // namespace
+
+  template <int dim>
+  void Simulator<dim>::resume(const std::string &path)
+  {
+    State            &s          = *state;
+    const Parameters &parameters = s.parameters;
+    AssertThrow(!s.set_up, dealii::ExcMessage("Simulator::resume() after setup(): call one of them."));
+    const std::string folder = checkpoint::find(path);
+    const RunState    r      = checkpoint::read_state(folder);
+    check_resumable(r, parameters, folder);
+    check_backend(parameters.backend);
+    std::future<void> cuda_ready;
+    if (parameters.backend == "cuda")
+      cuda_ready = start_cuda_initialisation(s.communicator);
+
+    s.h                 = parameters.cell_size;
+    s.c_el              = r.elastic_wave_speed;
+    s.m_min             = r.smallest_point_mass;
+    s.time              = r.time;
+    s.dt                = r.dt;
+    s.max_speed         = r.max_speed;
+    s.max_removed_speed = r.max_removed_speed;
+    s.work_of_gravity   = r.work_of_gravity;
+    s.balanced          = r.balanced;
+    s.next_output       = r.next_output;
+    s.step              = r.step;
+    s.n_points_initial  = r.n_points_initial;
+    s.n_removed         = r.n_removed;
+    s.n_resorts         = r.n_resorts;
+    s.n_repartitions    = r.n_repartitions;
+    s.equilibration     = r.equilibration;
+    s.plastic           = r.plastic;
+    s.materials         = parameters.materials;
+    for (auto &m : s.materials)
+      m.plasticity_enabled = s.plastic;
+
+    s.output = std::make_unique<OutputWriter<dim>>(parameters, s.communicator, /*resuming=*/true);
+    s.output->resume({r.n_outputs, r.grid_records, r.particle_records}, r.step);
+
+    // The grid evenly partitioned; each rank reads every rank's points and keeps those in its
+    // cells (one rank: all, including those that left the grid, as the engine held them).
+    const unsigned int rank = dealii::Utilities::MPI::this_mpi_process(s.communicator);
+    s.timer.enter_subsection("setup: grid");
+    s.grid   = std::make_unique<BackgroundGrid<dim>>(parameters, s.communicator);
+    s.points = std::make_unique<MaterialPoints<dim>>(*s.grid, parameters);
+    const BackgroundGrid<dim> &grid = *s.grid;
+    const PointSnapshot<dim>   saved =
+      checkpoint::read_points<dim>(folder, r, [&](const HostPoints<dim, double> &p, const int i) {
+        if (!s.parallel)
+          return true;
+        double x[dim];
+        for (int d = 0; d < dim; ++d)
+          x[d] = p.position[d][i];
+        return p.material[i] >= 0 && grid.owned_cell(grid.lattice_cell_of(x)) != grid.triangulation.end();
+      });
+    AssertThrow(saved.points.n_state_variables() == static_cast<int>(parameters.state_variable_names().size()),
+                dealii::ExcMessage("--resume: the points of '" + folder + "': " +
+                                   state_variable_count_mismatch(saved.points.n_state_variables(),
+                                                                 parameters.state_variable_names())));
+    if (!s.parallel)
+      s.points->replace(saved);
+    s.points->n_sent = rank == 0 ? r.n_sent : 0;
+    s.timer.leave_subsection();
+
+    s.resort_at = std::min(parameters.resort_distance * safe_distance_outside_home_cell(parameters.shape_function),
+                           s.parallel && parameters.pressure_averaging ? 0.5 : 1e300);
+    s.timer.enter_subsection("setup: engine");
+    if (cuda_ready.valid())
+      cuda_ready.get();
+    s.start_from(saved);
+    s.timer.leave_subsection();
+
+    s.print_header();
+    s.pcout << "  resumed from " << folder << " (written on " << r.n_ranks << " MPI rank(s)) at t = " << s.time
+            << " s, step " << s.step << std::endl;
+    s.apply_settings();
+    s.last_progress = s.last_checkpoint_wall = std::chrono::steady_clock::now();
+    s.last_checkpoint_step                   = s.step;
+    s.last_checkpoint                        = folder;
+    s.first_time                             = s.time;
+    s.first_step                             = s.step;
+    s.set_up                                 = true;
+    s.stepping_start                         = s.last_progress;
   }
 
   template <int dim>
@@ -987,27 +1286,38 @@ namespace mpm
       s.engine->load(*s.points);
   }
 
+  void request_checkpoint_and_stop()
+  {
+    stop_requested.store(true);
+  }
+
   namespace
   {
     template <int dim>
-    void run_from(const Parameters &parameters, MPI_Comm communicator)
+    bool run_from(const Parameters &parameters, MPI_Comm communicator, const std::string &resume_from)
     {
       Simulator<dim> simulator(parameters, communicator);
-      if (parameters.initial_state_source != "FEM file")
-        return simulator.run();
-      simulator.setup(load_fem_state_points<dim>(parameters, communicator));
+      if (!resume_from.empty())
+        simulator.resume(resume_from);
+      else if (parameters.initial_state_source == "FEM file")
+        simulator.setup(load_fem_state_points<dim>(parameters, communicator));
+      else
+        {
+          simulator.run();
+          return !simulator.stopped();
+        }
       while (!simulator.finished())
         simulator.advance();
       simulator.finish();
+      return !simulator.stopped();
     }
   } // namespace
 
-  void run_simulation(const Parameters &parameters, MPI_Comm communicator)
+  bool run_simulation(const Parameters &parameters, MPI_Comm communicator, const std::string &resume_from)
   {
     if (parameters.dim == 2)
-      run_from<2>(parameters, communicator);
-    else
-      run_from<3>(parameters, communicator);
+      return run_from<2>(parameters, communicator, resume_from);
+    return run_from<3>(parameters, communicator, resume_from);
   }
 
   template class Simulator<2>;

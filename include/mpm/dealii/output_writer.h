@@ -86,7 +86,20 @@ namespace mpm
   class OutputWriter
   {
   public:
-    OutputWriter(const Parameters &parameters, MPI_Comm communicator);
+    // resuming: the run continues a checkpoint (resume() follows); history.csv's rows are kept.
+    OutputWriter(const Parameters &parameters, MPI_Comm communicator, bool resuming = false);
+
+    // What a checkpoint keeps of the output: outputs written and the .pvd records.
+    struct Records
+    {
+      unsigned int                                 n_outputs = 0;
+      std::vector<std::pair<double, std::string>> grid, particles;
+    };
+    Records records() const { return {counter, grid_records, particle_records}; }
+    // A run resumed at `step` with the records of its checkpoint: later files number on
+    // from there, and history.csv keeps its rows up to that step (rows of steps after it,
+    // written before the run was stopped, are dropped: the resumed run writes them again).
+    void resume(const Records &records, long step);
     // Waits for a write in flight; an error there is reported by finish(), not here.
     ~OutputWriter();
 

@@ -68,6 +68,7 @@ namespace mpm
     double       plasticity_start_time;
     bool         pressure_averaging; // cell-wise volume-weighted pressure averaging
     unsigned int max_steps;
+    double       max_predicted_steps = 1e9; // refuse a first time step predicting more (guards.h)
 
     // Materials, in the order of their names; bodies refer to them by index.
     std::vector<std::string>                material_names;
@@ -76,6 +77,9 @@ namespace mpm
     // Random field of the parameter named by materials[m].field_parameter (core units:
     // Pa, rad), mean = the material's own value.
     std::vector<RandomFieldParameters>      material_fields;
+    // Per material: the largest fraction of its points whose field value may be raised to
+    // the floor (1e-3 of the mean) before the run is refused (Random field/Maximum clipped fraction).
+    std::vector<double>                     material_field_max_clipped;
     std::vector<BodyParameters>             bodies;
     std::vector<unsigned int>               body_material; // index into materials
 
@@ -90,6 +94,17 @@ namespace mpm
     std::string  output_compression;   // zlib level of the .vtu files: "best speed", ...
     bool         output_in_background; // compress and write files on a background thread
     unsigned int output_files_per_rank; // .vtu pieces per rank and output, written in parallel
+    unsigned int max_outputs = 10000;   // warn of more outputs than this; 0 = no warning
+
+    // Resources (guards.h)
+    double memory_limit = 0; // GB for the whole run; 0 = each node's available memory
+
+    // Checkpoint (doc/checkpoints.md)
+    unsigned int checkpoint_step_interval = 0;    // steps between checkpoints; 0 = none by steps
+    double       checkpoint_wall_interval = 0;    // wall-clock minutes between checkpoints; 0 = none
+    unsigned int checkpoint_keep          = 2;    // newest checkpoints kept
+    std::string  checkpoint_directory;            // "" = <Output/Directory>/checkpoints
+    bool         checkpoint_at_end        = false; // one more at the end of the run
 
     // Parallel runs (doc/performance.md, MPI)
     double resort_distance;        // re-sort at this fraction of the safe distance outside a home cell

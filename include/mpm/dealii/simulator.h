@@ -20,6 +20,7 @@
 #include <mpi.h>
 
 #include <memory>
+#include <string>
 #include <vector>
 
 namespace mpm
@@ -69,6 +70,21 @@ namespace mpm
     // setup(), advance() until finished(), finish().
     void run();
 
+    // Instead of setup(): continues the run from a checkpoint (doc/checkpoints.md): the
+    // folder of one (checkpoint-NNNNNNNNN) or the folder holding them (the newest complete one
+    // is taken), written by a run of the same scene on any number of ranks. The grid and the
+    // materials' names must be the prm's; End time, output, checkpoint and solver settings
+    // may differ and apply from the resumed step on. On as many ranks as wrote it (CPU), the
+    // resumed run ends bit-identical to the run that was not stopped.
+    void resume(const std::string &checkpoint);
+    // Writes a checkpoint of the run as it is after the last step, collectively, into
+    // Checkpoint/Directory, and returns its folder. advance() writes them where Checkpoint
+    // asks for them. On several ranks it re-sorts the points into cells and ranks first.
+    std::string write_checkpoint();
+    // True once a stop was requested (request_checkpoint_and_stop) and advance() has written
+    // the checkpoint for it; finished() is then true, and finish() reports the stop.
+    bool stopped() const;
+
     double time() const;
     long   step() const;
     // The equilibration's numbers (steps = 0 where Initial state/Equilibrate is false).
@@ -91,6 +107,13 @@ namespace mpm
     std::unique_ptr<State> state;
   };
 
-  // Runs the simulator of the parameter file's dimension (the executable).
-  void run_simulation(const Parameters &parameters, MPI_Comm communicator);
+  // Asks every running Simulator of this process to write a checkpoint after its current
+  // step and stop (stopped()). Async-signal-safe: the executable calls it on SIGTERM and
+  // SIGINT. On several ranks the first rank asked stops all of them at the same step.
+  void request_checkpoint_and_stop();
+
+  // Runs the simulator of the parameter file's dimension (the executable), from the
+  // checkpoint `resume_from` where it is not empty. Returns false where the run was stopped
+  // (request_checkpoint_and_stop) before its end, true where it ran to the end.
+  bool run_simulation(const Parameters &parameters, MPI_Comm communicator, const std::string &resume_from = "");
 } // namespace mpm
