@@ -31,6 +31,7 @@ namespace mpm
     archive &time &dt &max_speed &max_removed_speed &work_of_gravity &elastic_wave_speed &smallest_point_mass
       &balanced &next_output;
     archive &step &n_points_initial &n_removed &n_resorts &n_repartitions &n_sent &plastic;
+    archive &initial_mass &dropped_mass &n_dropped;
     archive &equilibration.steps &equilibration.wall_seconds &equilibration.reference_speed
       &equilibration.final_speed &equilibration.max_stress_change &equilibration.rms_stress_change;
     archive &n_outputs &grid_records &particle_records;

@@ -296,7 +296,7 @@ namespace mpm
           history << ",min_" << "xyz"[d];
         for (int d = 0; d < dim; ++d)
           history << ",max_" << "xyz"[d];
-        history << ",min_points_per_rank,max_points_per_rank,n_resorts,n_repartitions,n_sent";
+        history << ",min_points_per_rank,max_points_per_rank,n_resorts,n_repartitions,n_sent,removed_mass,mass_balance";
         history << "\n" << std::setprecision(16);
       }
   }
@@ -449,7 +449,7 @@ namespace mpm
     for (int d = 0; d < dim; ++d)
       history << ',' << r.totals.upper[d];
     history << ',' << r.min_points_per_rank << ',' << r.max_points_per_rank << ',' << r.n_resorts << ','
-            << r.n_repartitions << ',' << r.n_sent;
+            << r.n_repartitions << ',' << r.n_sent << ',' << r.removed_mass << ',' << r.mass_balance;
     history << '\n';
     history.flush();
   }

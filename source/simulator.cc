@@ -22,6 +22,7 @@
 #include <iomanip>
 #include <iostream>
 #include <unordered_map>
+#include <utility>
 
 namespace mpm
 {
@@ -41,6 +42,8 @@ namespace mpm
       t.mass           = sum(t.mass, comm);
       t.kinetic_energy = sum(t.kinetic_energy, comm);
       t.n_points       = sum(t.n_points, comm);
+      t.removed_mass   = sum(t.removed_mass, comm);
+      t.n_removed      = sum(t.n_removed, comm);
       for (int d = 0; d < dim; ++d)
         {
           t.momentum[d] = sum(t.momentum[d], comm);
@@ -133,6 +136,11 @@ namespace mpm
 
     long   n_points_initial = 0;
     double m_min            = 1e300;
+    // The loss checks (check_losses): the initial mass, and on this rank the points dropped
+    // from the engine after leaving the grid (re-sorts), their number and mass; the largest
+    // relative mass balance seen.
+    double initial_mass = 0, dropped_mass = 0, worst_mass_balance = 0;
+    long   n_dropped    = 0;
     // One rank: deal.II's grid and handler being built on a thread (see setup()).
     std::future<GridAndPoints> grid_build;
     const std::string          beside_grid          = "setup and first steps, beside deal.II's grid";
@@ -291,8 +299,7 @@ namespace mpm
             {
               {
                 dealii::TimerOutput::Scope scope(timer, "migrate points");
-                engine->resort(*points);
-                ++n_resorts;
+                resort();
               }
               if (balance())
                 engine->load(*points);
@@ -479,6 +486,9 @@ namespace mpm
       r.step                 = step;
       r.n_points_initial     = n_points_initial;
       r.n_removed            = n_removed;
+      r.initial_mass         = initial_mass;
+      r.n_dropped            = parallel ? static_cast<long>(sum(double(n_dropped), communicator)) : n_dropped;
+      r.dropped_mass         = parallel ? sum(dropped_mass, communicator) : dropped_mass;
       r.n_resorts            = n_resorts;
       r.n_repartitions       = n_repartitions;
       r.n_sent               = parallel ? static_cast<long>(sum(double(points->n_sent), communicator)) : 0;
@@ -517,8 +527,7 @@ namespace mpm
       PointSnapshot<dim>         snapshot;
       if (parallel)
         {
-          engine->resort(*points); // every point on the rank owning its cell
-          ++n_resorts;
+          resort(); // every point on the rank owning its cell
         }
       engine->snapshot(snapshot);
       last_checkpoint = checkpoint::write<dim>(parameters.checkpoint_directory, run_state(), snapshot,
@@ -553,13 +562,60 @@ namespace mpm
       engine->set_sort_interval(parameters.sort_interval);
     }
 
+    // The MPI re-sort, counting the points it drops (those that left the grid): they must be
+    // the ones the engine held as removed.
+    void resort()
+    {
+      const PointTotals<dim, double> held    = engine->totals();
+      const unsigned int             dropped = engine->resort(*points);
+      AssertThrow(static_cast<long>(dropped) == held.n_removed,
+                  dealii::ExcMessage("Internal error (loss check): a re-sort dropped " + std::to_string(dropped) +
+                                     " points, but " + std::to_string(held.n_removed) +
+                                     " had left the grid on this rank."));
+      n_dropped += held.n_removed;
+      dropped_mass += held.removed_mass;
+      ++n_resorts;
+    }
+
+    // Points are never made or lost but by leaving the grid: the points in the grid and those
+    // removed make the initial number exactly, and their masses the initial mass to round-off
+    // (1e-9: the sums' order differs). Throws where either fails: a bug, not a bad input.
+    // Returns (removed mass, relative mass balance).
+    std::pair<double, double> check_losses(const PointTotals<dim, double> &totals)
+    {
+      double       local[2] = {double(n_dropped), dropped_mass}, global[2] = {local[0], local[1]};
+      if (parallel)
+        dealii::Utilities::MPI::sum(dealii::ArrayView<const double>(local, 2), communicator,
+                                    dealii::ArrayView<double>(global, 2));
+      const long   removed      = totals.n_removed + static_cast<long>(global[0]);
+      const double removed_mass = totals.removed_mass + global[1];
+      const double balance      = (totals.mass + removed_mass - initial_mass) / initial_mass;
+      n_removed                 = removed;
+      worst_mass_balance        = std::max(worst_mass_balance, std::abs(balance));
+      const std::string when    = " at t = " + dealii::Utilities::to_string(time) + " s (step " + std::to_string(step) + ")";
+      AssertThrow(totals.n_points + removed == n_points_initial,
+                  dealii::ExcMessage("Internal error (loss check)" + when + ": " + std::to_string(totals.n_points) +
+                                     " material points in the grid and " + std::to_string(removed) +
+                                     " removed make " + std::to_string(totals.n_points + removed) + ", not the " +
+                                     std::to_string(n_points_initial) + " the run started with."));
+      AssertThrow(std::abs(balance) <= 1e-9,
+                  dealii::ExcMessage("Internal error (loss check)" + when + ": the mass in the grid (" +
+                                     dealii::Utilities::to_string(totals.mass) + " kg) and the mass removed (" +
+                                     dealii::Utilities::to_string(removed_mass) + " kg) differ from the initial " +
+                                     dealii::Utilities::to_string(initial_mass) + " kg by a relative " +
+                                     dealii::Utilities::to_string(balance) + ", beyond round-off (1e-9)."));
+      return {removed_mass, balance};
+    }
+
     void record_history()
     {
       timed("history", [&]() {
         const auto local  = engine->totals();
         const auto totals = parallel ? global_totals<dim>(local, communicator) : local;
-        n_removed         = n_points_initial - totals.n_points;
+        const auto [removed_mass, balance] = check_losses(totals);
         typename OutputWriter<dim>::HistoryRow row{time, dt, work_of_gravity, step, n_removed, totals};
+        row.removed_mass = removed_mass;
+        row.mass_balance = balance;
         row.min_points_per_rank = static_cast<long>(global_min(double(local.n_points)));
         row.max_points_per_rank = static_cast<long>(global_max(double(local.n_points)));
         row.n_resorts           = n_resorts;
@@ -817,7 +873,10 @@ namespace mpm
         {
           s.n_points_initial += body.points.size();
           for (const double m : body.points.mass)
-            s.m_min = std::min(s.m_min, m);
+            {
+              s.m_min = std::min(s.m_min, m);
+              s.initial_mass += m;
+            }
         }
       AssertThrow(s.n_points_initial > 0,
                   dealii::ExcMessage("Parameter 'Material points': the bodies contain no material point (each "
@@ -1022,7 +1081,10 @@ namespace mpm
             << std::setprecision(3) << (n_now * steps) / wall << " point-updates/s); " << s.n_removed
             << " material point(s) left the grid and were removed.\n"
             << "  set-up " << wall - stepping << " s, then " << stepping << " s of steps and output ("
-            << (n_now * steps) / stepping << " point-updates/s)\n";
+            << (n_now * steps) / stepping << " point-updates/s)\n"
+            << "  loss checks: " << s.n_points_initial - s.n_removed << " points in the grid + " << s.n_removed
+            << " removed = " << s.n_points_initial << " initial; mass in the grid + removed = initial mass to "
+            << s.worst_mass_balance << " (largest relative difference over the history rows)\n";
     if (s.parallel)
       {
         s.pcout << "  MPI: " << s.n_resorts << " re-sorts of the points into cells and ranks, "
@@ -1115,6 +1177,7 @@ namespace mpm
     s.step              = r.step;
     s.n_points_initial  = r.n_points_initial;
     s.n_removed         = r.n_removed;
+    s.initial_mass      = r.initial_mass;
     s.n_resorts         = r.n_resorts;
     s.n_repartitions    = r.n_repartitions;
     s.equilibration     = r.equilibration;
@@ -1137,6 +1200,15 @@ namespace mpm
       checkpoint::read_points<dim>(folder, r, [&](const HostPoints<dim, double> &p, const int i) {
         if (!s.parallel)
           return true;
+        if (p.material[i] < 0) // left the grid (saved by one rank): dropped here, counted once
+          {
+            if (rank == 0)
+              {
+                ++s.n_dropped;
+                s.dropped_mass += p.mass[i];
+              }
+            return false;
+          }
         double x[dim];
         for (int d = 0; d < dim; ++d)
           x[d] = p.position[d][i];
@@ -1149,6 +1221,11 @@ namespace mpm
     if (!s.parallel)
       s.points->replace(saved);
     s.points->n_sent = rank == 0 ? r.n_sent : 0;
+    if (rank == 0) // the sums over ranks
+      {
+        s.n_dropped    += r.n_dropped;
+        s.dropped_mass += r.dropped_mass;
+      }
     s.timer.leave_subsection();
 
     s.resort_at = std::min(parameters.resort_distance * safe_distance_outside_home_cell(parameters.shape_function),
@@ -1235,8 +1312,23 @@ namespace mpm
     AssertThrow(wrong.empty(), dealii::ExcMessage("Simulator::set_points(): " + wrong));
     AssertThrow(!refused_anywhere, dealii::ExcMessage("Simulator::set_points(): another MPI rank's points were "
                                                       "refused (its message says why)."));
+    // The loss checks take the points as given: their masses may have changed (the new
+    // initial mass), and on several ranks those marked as having left the grid are dropped.
+    const auto rebase_initial_mass = [&]() {
+      const PointTotals<dim, double> t = s.engine->totals();
+      s.initial_mass = s.global_sum(t.mass + t.removed_mass + s.dropped_mass);
+    };
     if (!s.parallel)
-      return s.engine->load(new_points, snapshot.labels);
+      {
+        s.engine->load(new_points, snapshot.labels);
+        return rebase_initial_mass();
+      }
+    for (int i = 0; i < new_points.size(); ++i)
+      if (new_points.material[i] < 0)
+        {
+          ++s.n_dropped;
+          s.dropped_mass += new_points.mass[i];
+        }
     // Points may have been moved any distance: every rank gets all of them (as setup()
     // gets handed-over points) and keeps those in its cells, ids and labels kept.
     dealii::TimerOutput::Scope scope(s.timer, "migrate points");
@@ -1284,6 +1376,7 @@ namespace mpm
     ++s.n_resorts;
     if (s.balance())
       s.engine->load(*s.points);
+    rebase_initial_mass();
   }
 
   void request_checkpoint_and_stop()

@@ -6,7 +6,8 @@
   --energy-bounded            the kinetic energy never exceeds the work done by gravity (+1%; the
                               initial elastic energy of the scenes that use it is negligible)
   --at-rest F                 the final kinetic energy is below F times the work done by gravity
-  (with --removed-at-least, also: the mass left is that of the points left)"""
+  (with --removed-at-least, also: the mass left is that of the points left, and on every row
+  the mass left and the removed mass make the initial mass, the run's own loss check)"""
 import argparse
 import os
 import sys
@@ -58,6 +59,12 @@ if args.removed_at_least:
     point_mass = h["total_mass"][0] / h["n_points"][0]
     if abs(h["total_mass"][-1] - point_mass * h["n_points"][-1]) > 1e-12 * h["total_mass"][0]:
         print("FAILED: the mass left does not match the points left")
+        failed = True
+    balance = (h["total_mass"] + h["removed_mass"] - h["total_mass"][0]) / h["total_mass"][0]
+    print(f"mass left + removed mass - initial mass: at most {np.max(np.abs(balance)):.3e} of the initial mass"
+          f" (the run's own column: {np.max(np.abs(h['mass_balance'])):.3e})")
+    if not np.max(np.abs(balance)) <= 1e-12 or not np.max(np.abs(h["mass_balance"])) <= 1e-12:
+        print("FAILED: mass lost or made")
         failed = True
 if args.energy_bounded:
     excess = np.max(h["kinetic_energy"] - 1.01 * np.maximum(h["work_of_gravity"], 0))

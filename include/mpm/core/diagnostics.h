@@ -1,5 +1,7 @@
 // Totals over the material points for the time history: mass, kinetic energy,
-// linear momentum, number of points and bounding box of the material.
+// linear momentum, number of points and bounding box of the material; and the number and
+// mass of the points marked as having left the grid that the arrays still hold (the loss
+// checks count them with those already dropped).
 #pragma once
 
 #include <mpm/core/views.h>
@@ -14,14 +16,16 @@ namespace mpm
     Real momentum[dim];
     Real lower[dim], upper[dim];
     long n_points;
+    Real removed_mass; // points with material < 0, still held
+    long n_removed;
   };
 
   template <int dim, typename Real, typename Backend>
   PointTotals<dim, Real> point_totals(Backend &backend, const PointsView<dim, Real> &p)
   {
     PointTotals<dim, Real> identity;
-    identity.mass = identity.kinetic_energy = Real(0);
-    identity.n_points                       = 0;
+    identity.mass = identity.kinetic_energy = identity.removed_mass = Real(0);
+    identity.n_points = identity.n_removed = 0;
     for (int d = 0; d < dim; ++d)
       {
         identity.momentum[d] = Real(0);
@@ -33,7 +37,11 @@ namespace mpm
       [=] MPM_HOST_DEVICE(const int i) {
         PointTotals<dim, Real> t = identity;
         if (p.material[i] < 0)
-          return t;
+          {
+            t.removed_mass = p.mass[i];
+            t.n_removed    = 1;
+            return t;
+          }
         t.mass     = p.mass[i];
         t.n_points = 1;
         for (int d = 0; d < dim; ++d)
@@ -50,6 +58,8 @@ namespace mpm
         r.mass           = a.mass + b.mass;
         r.kinetic_energy = a.kinetic_energy + b.kinetic_energy;
         r.n_points       = a.n_points + b.n_points;
+        r.removed_mass   = a.removed_mass + b.removed_mass;
+        r.n_removed      = a.n_removed + b.n_removed;
         for (int d = 0; d < dim; ++d)
           {
             r.momentum[d] = a.momentum[d] + b.momentum[d];

@@ -36,6 +36,9 @@ namespace mpm
     double time = 0, dt = 0, max_speed = 0, max_removed_speed = 0, work_of_gravity = 0, elastic_wave_speed = 0,
            smallest_point_mass = 0, balanced = 1, next_output = 0;
     long step = 0, n_points_initial = 0, n_removed = 0, n_resorts = 0, n_repartitions = 0, n_sent = 0;
+    // The loss checks: the initial mass, and the points dropped after leaving the grid.
+    double initial_mass = 0, dropped_mass = 0;
+    long   n_dropped    = 0;
     bool plastic = false;
     EquilibrationReport equilibration;
 

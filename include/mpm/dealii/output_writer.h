@@ -128,6 +128,9 @@ namespace mpm
       // Parallel bookkeeping: fewest and most points on one rank, re-sorts of the points
       // into cells and ranks, repartitions of the grid, points handed to another rank.
       long min_points_per_rank = 0, max_points_per_rank = 0, n_resorts = 0, n_repartitions = 0, n_sent = 0;
+      // The loss checks: mass of the points removed so far (left the grid), and (mass in the
+      // grid + removed mass - initial mass) / initial mass.
+      double removed_mass = 0, mass_balance = 0;
     };
     void write_history(const HistoryRow &row);
 

@@ -542,7 +542,7 @@ namespace mpm
   private:
     static constexpr int    reduce_threads      = 256;
     static constexpr int    max_reduce_blocks   = 1024;
-    static constexpr size_t max_reduction_bytes = 128; // PointTotals<3, double> is 96
+    static constexpr size_t max_reduction_bytes = 128; // PointTotals<3, double> is 112
 
     cudaStream_t stream;
     void        *scratch     = nullptr;
