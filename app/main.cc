@@ -77,11 +77,24 @@ int main(int argc, char **argv)
         }
       if (first == "--print-parameters")
         {
-          const unsigned int dim = argc > 2 ? std::stoi(argv[2]) : 2;
-          if (dim != 2 && dim != 3)
-            throw std::runtime_error("--print-parameters: the dimension must be 2 or 3.");
+          const std::string dim   = argc > 2 ? argv[2] : "2";
+          const std::string style = argc > 3 ? argv[3] : "prm";
+          if (argc > 4 || (dim != "2" && dim != "3") ||
+              (style != "prm" && style != "description" && style != "json"))
+            {
+              if (root)
+                {
+                  std::cerr << "dealii-mpm: error: --print-parameters takes a dimension 2 or 3 and a style prm, "
+                               "description or json, got '";
+                  for (int a = 2; a < argc; ++a)
+                    std::cerr << (a > 2 ? " " : "") << argv[a];
+                  std::cerr << "'.\n\n";
+                  print_help(std::cerr);
+                }
+              return 2;
+            }
           if (root)
-            mpm::print_parameters(std::cout, dim, argc > 3 ? argv[3] : "prm");
+            mpm::print_parameters(std::cout, std::stoi(dim), style);
           return 0;
         }
       // scene.prm, or scene.prm --resume DIR (either order).
@@ -100,7 +113,10 @@ int main(int argc, char **argv)
       if (!well_formed || prm.empty() || (argc == 4 && resume.empty()))
         {
           if (root)
-            print_help(std::cerr);
+            {
+              std::cerr << "dealii-mpm: error: the command line is not one of the forms below.\n\n";
+              print_help(std::cerr);
+            }
           return 2;
         }
       const mpm::Parameters parameters = mpm::read_parameters(prm);

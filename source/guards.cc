@@ -103,8 +103,7 @@ namespace mpm
                       for (auto p = path.rbegin(); p != path.rend(); ++p)
                         entry = *p + "/" + entry;
                     }
-                  warn_about_parameter(entry.empty() ? name + ", line " + std::to_string(n + 1) : entry,
-                                       "line " + std::to_string(n + 1) + " of '" + name +
+                  warn_about_parameter(entry, "line " + std::to_string(n + 1) + " of the parameter file '" + name +
                                          "' ends in a backslash, which continues it on the next line" +
                                          (at_end ? " (there is none)" :
                                                    ": line " + std::to_string(n + 2) + " ('" + lines[n + 1] +
@@ -228,7 +227,7 @@ namespace mpm
     MPI_Finalized(&finalized);
     if (initialized && !finalized && dealii::Utilities::MPI::this_mpi_process(MPI_COMM_WORLD) != 0)
       return;
-    std::cerr << "dealii-mpm: warning: Parameter '" << entry << "': " << text << std::endl;
+    std::cerr << "dealii-mpm: warning: " << (entry.empty() ? "" : "Parameter '" + entry + "': ") << text << std::endl;
   }
 
   void check_parameter_file(const std::string &filename)
@@ -393,7 +392,9 @@ namespace mpm
     // Warnings: the run goes on.
     if (p.output_interval > 0 && p.max_outputs > 0 && (p.write_grid_fields || p.write_particles))
       {
-        const double outputs = std::floor(p.end_time / p.output_interval * (1 + 1e-12)) + 1;
+        double outputs = std::floor(p.end_time / p.output_interval * (1 + 1e-12)) + 1;
+        if (p.max_steps > 0)
+          outputs = std::min(outputs, p.max_steps + 1.0); // at most one a step
         if (outputs > p.max_outputs)
           warn_about_parameter("Output/Output interval",
                                number(p.output_interval) + " s up to Solver/End time = " + number(p.end_time) +

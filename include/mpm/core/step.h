@@ -779,11 +779,16 @@ namespace mpm
           r.max_speed = std::sqrt(v2);
           return r;
         },
+        // A speed that is not a number wins the maximum (a != a): a blow-up cannot hide behind
+        // the order in which the threads combine.
         [] MPM_HOST_DEVICE(const StepReduction<Real> &a, const StepReduction<Real> &b) {
-          return StepReduction<Real>{a.max_speed > b.max_speed ? a.max_speed : b.max_speed,
+          return StepReduction<Real>{a.max_speed > b.max_speed || a.max_speed != a.max_speed ? a.max_speed :
+                                                                                                b.max_speed,
                                      a.gravity_power + b.gravity_power,
-                                     a.max_removed_speed > b.max_removed_speed ? a.max_removed_speed :
-                                                                                 b.max_removed_speed};
+                                     a.max_removed_speed > b.max_removed_speed ||
+                                         a.max_removed_speed != a.max_removed_speed ?
+                                       a.max_removed_speed :
+                                       b.max_removed_speed};
         });
     }
   } // namespace stages

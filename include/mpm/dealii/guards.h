@@ -22,8 +22,8 @@
 
 namespace mpm
 {
-  // "dealii-mpm: warning: Parameter 'entry': text" on stderr, from rank 0 of MPI_COMM_WORLD
-  // only (every rank finds the same from the same prm).
+  // "dealii-mpm: warning: Parameter 'entry': text" (entry empty: "dealii-mpm: warning: text")
+  // on stderr, from rank 0 of MPI_COMM_WORLD only (every rank finds the same from the same prm).
   void warn_about_parameter(const std::string &entry, const std::string &text);
 
   // The text of the parameter file `filename` (and the files it includes), as deal.II's
