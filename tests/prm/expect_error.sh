@@ -17,5 +17,6 @@ echo "$output"
 echo "exit status: $status"
 if [ $status -eq 0 ]; then echo "FAILED: expected a non-zero exit"; exit 1; fi
 if [ $status -ge 124 ]; then echo "FAILED: crashed, hung or was killed (status $status)"; exit 1; fi
+if grep -qF "TimerOutput objects finalize" <<< "$output"; then echo "FAILED: deal.II's TimerOutput banner came before the error"; exit 1; fi
 if ! grep -qF -- "$expected" <<< "$output"; then echo "FAILED: the message does not name '$expected'"; exit 1; fi
 echo "ok: non-zero exit naming '$expected'"
