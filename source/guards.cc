@@ -74,8 +74,12 @@ namespace mpm
 
     void scan_text(std::istream &input, const std::string &name, std::vector<std::string> path, TextScan &scan)
     {
-      // entry path -> (line, value) of its last 'set' in this file
-      std::map<std::string, std::pair<unsigned int, std::string>> set_at;
+      // (entry path, subsection block) -> (line, value) of its last 'set' in this file. A block
+      // is one 'subsection ... end' (0: the top level): a subsection opened again later, as
+      // overrides appended to a scene are, may set an entry again without a warning.
+      std::map<std::pair<std::string, unsigned int>, std::pair<unsigned int, std::string>> set_at;
+      std::vector<unsigned int> blocks;
+      unsigned int              n_blocks = 0;
       std::vector<std::string> lines;
       for (std::string line; std::getline(input, line);)
         lines.push_back(dealii::Utilities::trim(line));
@@ -124,11 +128,16 @@ namespace mpm
           first_line = 0;
 
           if (starts_with(s, "subsection "))
-            path.push_back(dealii::Utilities::trim(s.substr(11)));
+            {
+              path.push_back(dealii::Utilities::trim(s.substr(11)));
+              blocks.push_back(++n_blocks);
+            }
           else if (starts_with(s, "end"))
             {
               if (!path.empty())
                 path.pop_back();
+              if (!blocks.empty())
+                blocks.pop_back();
             }
           else if (starts_with(s, "set ") && s.find('=') != std::string::npos)
             {
@@ -137,13 +146,14 @@ namespace mpm
               const std::string value = dealii::Utilities::trim(s.substr(s.find('=') + 1));
               for (auto p = path.rbegin(); p != path.rend(); ++p)
                 entry = *p + "/" + entry;
-              const auto before = set_at.find(entry);
+              const auto key    = std::make_pair(entry, blocks.empty() ? 0u : blocks.back());
+              const auto before = set_at.find(key);
               if (before != set_at.end())
-                warn_about_parameter(entry, "set twice in '" + name + "', in line " +
+                warn_about_parameter(entry, "set twice in one subsection of '" + name + "', in line " +
                                               std::to_string(before->second.first) + " (" + before->second.second +
                                               ") and in line " + std::to_string(where) + " (" + value +
                                               "); the last value is used. Remove one of them.");
-              set_at[entry] = {where, value};
+              set_at[key] = {where, value};
             }
           else if (starts_with(s, "include "))
             {

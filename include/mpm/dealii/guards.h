@@ -31,7 +31,8 @@ namespace mpm
   // (empty, or comments only) and a file that includes itself directly or through others
   // (naming the file and line); warns of a line ending in a backslash (deal.II joins the next
   // line to it) where the next line is a statement of its own, and of an entry set twice in
-  // one subsection (the last value wins).
+  // one 'subsection ... end' block of one file (the last value wins; a subsection opened again
+  // later, as overrides appended to a scene are, is not warned of).
   void check_parameter_file(const std::string &filename);
   // The same checks of prm text given as a string (no refusal of an empty text).
   void check_parameter_text(const std::string &text);
