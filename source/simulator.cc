@@ -1007,6 +1007,15 @@ namespace mpm
               s.m_min = std::min(s.m_min, m);
               s.initial_mass += m;
             }
+          // The first adaptive time step heeds the bodies' initial velocity (after a step
+          // the step's own largest speed does).
+          for (int i = 0; i < body.points.size(); ++i)
+            {
+              double v2 = 0;
+              for (int d = 0; d < dim; ++d)
+                v2 += body.points.velocity[d][i] * body.points.velocity[d][i];
+              s.max_speed = std::max(s.max_speed, std::sqrt(v2));
+            }
         }
       AssertThrow(s.n_points_initial > 0,
                   dealii::ExcMessage("Parameter 'Material points': the bodies contain no material point (each "
