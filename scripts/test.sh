@@ -4,5 +4,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
-cd build
-ctest -j "$(nproc)" --output-on-failure --timeout 900
+(cd build && ctest -j "$(nproc)" --output-on-failure --timeout 900)
+# Our code again with AddressSanitizer + UndefinedBehaviorSanitizer in build-asan (only the core
+# tests and the executable), and the core tests and short prm scenes there (doc/guards.md).
+bash scripts/sanitize.sh

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <memory>
 #include <sstream>
@@ -76,16 +77,21 @@ namespace mpm
     // Work of a cell for p4est's weighted partition (deal.II's 'weight' signal, no base
     // weight): an empty cell costs 1 unit (node updates), each point Point weight units.
     // Integer weights: scaled by 16 so that fractional point weights keep their meaning.
+    // p4est reads each cell's weight as an int: both are capped there (a Point weight of 1e9
+    // wrapped around to a negative weight, and p4est's partition aborted).
+    constexpr double   max_weight   = std::numeric_limits<int>::max();
     const unsigned int cell_weight  = 16;
-    const unsigned int point_weight = static_cast<unsigned int>(std::lround(16 * parameters.point_weight));
+    const unsigned int point_weight =
+      static_cast<unsigned int>(std::min(std::round(16 * parameters.point_weight), max_weight));
     this->point_weight              = point_weight / 16.;
     using CellStatus = typename dealii::Triangulation<dim>::CellStatus;
     weight_connection = grid.triangulation.signals.weight.connect(
-      [this, cell_weight, point_weight](const typename dealii::Triangulation<dim>::cell_iterator &cell,
-                                        const CellStatus status) -> unsigned int {
+      [this, cell_weight, point_weight, max_weight](const typename dealii::Triangulation<dim>::cell_iterator &cell,
+                                                    const CellStatus status) -> unsigned int {
         // The background grid is never refined or coarsened: only CELL_PERSIST occurs.
         (void)status;
-        return cell_weight + point_weight * handler.n_particles_in_cell(cell);
+        return static_cast<unsigned int>(
+          std::min(cell_weight + double(point_weight) * handler.n_particles_in_cell(cell), max_weight));
       });
   }
 

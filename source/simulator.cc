@@ -1148,7 +1148,14 @@ namespace mpm
     if (parameters.output_interval > 0 && s.time >= s.next_output * (1 - 1e-12))
       {
         s.write_output();
-        while (s.next_output <= s.time * (1 + 1e-12))
+        const double due = s.time * (1 + 1e-12);
+        // An interval below the step (the step is at least 1e-12 End time) would take this loop
+        // an interval at a time up to now: 1e296 turns for 1e-300 s, and for one below the
+        // round-off of the time it never ends. Jump past now instead.
+        if (s.next_output + parameters.output_interval <= due)
+          s.next_output =
+            std::max(due + parameters.output_interval, std::nextafter(due, std::numeric_limits<double>::infinity()));
+        while (s.next_output <= due)
           s.next_output += parameters.output_interval;
       }
 
