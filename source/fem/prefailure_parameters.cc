@@ -251,6 +251,11 @@ namespace mpm::fem
           fail("Factor increment", "must be > 0.");
         if (!(factor_tolerance > 0) || !(factor_tolerance < factor_increment))
           fail("Factor tolerance", "must be > 0 and below Factor increment (" + std::to_string(factor_increment) + ").");
+        // A step below the round-off of F leaves F where it was: the search then tried the same
+        // factor for ever (Factor increment = 1e-300: F = 1 + 1e-300 is F = 1).
+        if (!(factor_tolerance >= 1e-9 * maximum_factor))
+          fail("Factor tolerance", "must be at least 1e-9 x Maximum factor: the search cannot tell closer "
+                                   "factors apart.");
       }
     if (!(residual_tolerance > 0))
       fail("Residual tolerance", "must be > 0.");
