@@ -9,9 +9,9 @@ expected=$(sed -n '1s/^# expect: //p' "$prm")
 cd "$(mktemp -d)"
 if [ "$np" -gt 1 ]; then
   export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
-  output=$(timeout 120 mpirun --oversubscribe -np "$np" "$exe" "$prm" 2>&1); status=$?
+  output=$(timeout -k 10 120 mpirun --oversubscribe -np "$np" "$exe" "$prm" 2>&1); status=$?
 else
-  output=$(timeout 120 "$exe" "$prm" 2>&1); status=$?
+  output=$(timeout -k 10 120 "$exe" "$prm" 2>&1); status=$?
 fi
 echo "$output"
 echo "exit status: $status"

@@ -7,7 +7,7 @@ texts=()
 while [ $# -gt 0 ] && [ "$1" != "--" ]; do texts+=("$1"); shift; done
 shift
 cd "$(mktemp -d)"
-output=$(timeout 120 "$@" 2>&1); status=$?
+output=$(timeout -k 10 120 "$@" 2>&1); status=$?
 echo "$output"
 echo "exit status: $status"
 if [ $status -eq 0 ]; then echo "FAILED: expected a non-zero exit"; exit 1; fi

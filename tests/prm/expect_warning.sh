@@ -9,9 +9,9 @@ expected=$(sed -n '1s/^# warn: //p' "$prm")
 cd "$(mktemp -d)"
 if [ "$np" -gt 1 ]; then
   export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
-  errors=$(timeout 120 mpirun --oversubscribe -np "$np" "$exe" "$prm" 2>&1 >/dev/null); status=$?
+  errors=$(timeout -k 10 120 mpirun --oversubscribe -np "$np" "$exe" "$prm" 2>&1 >/dev/null); status=$?
 else
-  errors=$(timeout 120 "$exe" "$prm" 2>&1 >/dev/null); status=$?
+  errors=$(timeout -k 10 120 "$exe" "$prm" 2>&1 >/dev/null); status=$?
 fi
 echo "$errors"
 echo "exit status: $status"
