@@ -275,8 +275,10 @@ namespace mpm
         else
           {
             // A resumed run continues the rows of the stopped one (resume()): kept aside here.
+            // Where a file is already kept aside, a resume failed after this point (a damaged
+            // checkpoint): that one holds the rows, and the history.csv beside it only a header.
             std::error_code ignored;
-            if (resuming)
+            if (resuming && !std::filesystem::exists(output_directory + "/history.csv.stopped"))
               std::filesystem::rename(output_directory + "/history.csv", output_directory + "/history.csv.stopped",
                                       ignored);
             history.open(output_directory + "/history.csv");

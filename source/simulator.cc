@@ -1194,6 +1194,7 @@ namespace mpm
     s.join_grid(); // a short run may end before the grid thread does
     if (s.stopped)
       {
+        stop_requested.store(false); // honoured: a later Simulator of this process runs on
         dealii::TimerOutput::Scope scope(s.timer, "output");
         s.output->finish();
         s.pcout << "dealii-mpm: stopped on request at t = " << s.time << " s after " << s.step

@@ -4,7 +4,8 @@
 # End time raised to 0.04 s it must end where a run straight to 0.04 s ends (to round-off:
 # the end's checkpoint re-sorts the points). Then --resume must refuse, with a message naming
 # what is wrong and a non-zero exit below 128: a folder without checkpoints, a damaged
-# run.state, a checkpoint of another grid (Grid/Cell size), a missing FOLDER argument.
+# run.state, a checkpoint of another grid (Grid/Cell size), a missing FOLDER argument. A resume
+# that fails on damaged points leaves history.csv's rows for the next one.
 #   checkpoint_extend.sh EXE OUTDIR
 set -eu
 exe=$1 out=$2
@@ -22,9 +23,18 @@ scene 0.04 extended > long.prm
 "$exe" straight.prm > straight.log
 "$exe" short.prm > short.log
 ls extended/checkpoints/checkpoint-* -d
+# A first resume fails on a damaged points file after the output is set up: the rows of the
+# run so far must survive it (history.csv is kept aside, not overwritten, by the second try).
+cp -r extended/checkpoints/checkpoint-* broken && head -c 100 extended/checkpoints/checkpoint-*/points.0 > broken/points.0
+! "$exe" long.prm --resume broken > broken.log 2>&1 || { echo "FAILED: a damaged points file was accepted"; exit 1; }
+grep -q "the checkpoint is damaged" broken.log || { echo "FAILED: no message for the damaged points"; cat broken.log; exit 1; }
 "$exe" long.prm --resume extended/checkpoints > long.log
 grep "resumed from" long.log
 /usr/bin/python3 "$here/compare_np.py" straight extended --rtol 1e-10
+# (the short run's last row, at 0.02 s, stays as well)
+missing=$(grep -vxFf <(cut -d, -f1-3 extended/history.csv) <(cut -d, -f1-3 straight/history.csv) || true)
+[ -z "$missing" ] || { echo "FAILED: history.csv of the resumed run lacks rows of the straight run:"; echo "$missing"; exit 1; }
+echo "ok: history.csv holds every row (time, dt, step) of the straight run"
 
 refuse() { # EXPECTED_TEXT ARGS...: a non-zero exit below 128 and a message holding the text
   local expected=$1; shift

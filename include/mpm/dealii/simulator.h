@@ -107,9 +107,10 @@ namespace mpm
     std::unique_ptr<State> state;
   };
 
-  // Asks every running Simulator of this process to write a checkpoint after its current
-  // step and stop (stopped()). Async-signal-safe: the executable calls it on SIGTERM and
-  // SIGINT. On several ranks the first rank asked stops all of them at the same step.
+  // Asks the running Simulator of this process to write a checkpoint after its current step
+  // and stop (stopped()); its finish() clears the request, so that a Simulator made later
+  // runs on. Async-signal-safe: the executable calls it on SIGTERM and SIGINT. On several
+  // ranks the first rank asked stops all of them at the same step.
   void request_checkpoint_and_stop();
 
   // Runs the simulator of the parameter file's dimension (the executable), from the
