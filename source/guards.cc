@@ -161,6 +161,12 @@ namespace mpm
               std::ifstream     included(file);
               if (file.empty() || !included)
                 continue; // deal.II's own message names the line
+              // A folder reads as empty, /dev/zero or /dev/urandom never end: only a file is read.
+              AssertThrow(std::filesystem::is_regular_file(file),
+                          ExcMessage("The parameter file '" + name + "', line " + std::to_string(where) +
+                                     ": 'include " + file + "' names " +
+                                     (std::filesystem::is_directory(file) ? "a folder" : "a device or pipe") +
+                                     ", not a file. Include a parameter file (.prm) by its path."));
               std::error_code   error;
               const std::string canonical = std::filesystem::weakly_canonical(file, error).string();
               const auto        cycle     = std::find(scan.including.begin(), scan.including.end(), canonical);
@@ -246,6 +252,9 @@ namespace mpm
                 ExcMessage("The parameter file '" + filename + "' is a folder, not a file. Give the scene's "
                            "parameter file: dealii-mpm scene.prm (a .prm file; dealii-mpm --print-parameters 2 "
                            "prints every entry with its default)."));
+    AssertThrow(!std::filesystem::exists(filename) || std::filesystem::is_regular_file(filename),
+                ExcMessage("The parameter file '" + filename + "' is a device or pipe, not a file. Give the "
+                           "scene's parameter file: dealii-mpm scene.prm."));
     const std::string ending = filename.substr(filename.find_last_of('.') + 1);
     if (ending != "prm" && ending != "PRM")
       return; // .xml, .json: deal.II reads them whole; other endings it refuses itself

@@ -41,9 +41,32 @@ namespace mpm
       return Patterns::List(Patterns::Double(), dim, dim, ",");
     }
 
-    std::vector<double> get_point(ParameterHandler &prm, const std::string &entry)
+    [[noreturn]] void fail(const std::string &entry, const std::string &what);
+
+    // The numbers of a list entry. The pattern has checked their form, but not their range: a
+    // value such as 1e-400 matches Patterns::Double and still does not convert.
+    std::vector<double> to_doubles(const std::string &entry, const std::string &text)
     {
-      return dealii::Utilities::string_to_double(dealii::Utilities::split_string_list(prm.get(entry), ','));
+      std::vector<double> values;
+      for (const std::string &item : dealii::Utilities::split_string_list(text, ','))
+        {
+          try
+            {
+              values.push_back(dealii::Utilities::string_to_double(item));
+            }
+          catch (...)
+            {
+              fail(entry, "'" + item + "' is not a finite double-precision number (magnitudes from about "
+                          "2.2e-308 to 1.8e308, or 0).");
+            }
+        }
+      return values;
+    }
+
+    // where: the subsection path of the entry, for the message.
+    std::vector<double> get_point(ParameterHandler &prm, const std::string &entry, const std::string &where)
+    {
+      return to_doubles(where + entry, prm.get(entry));
     }
 
     std::string join(const std::vector<std::string> &items)
@@ -371,8 +394,8 @@ namespace mpm
     dim = prm.get_integer("Dimension");
 
     prm.enter_subsection("Grid");
-    lower     = get_point(prm, "Lower corner");
-    upper     = get_point(prm, "Upper corner");
+    lower     = get_point(prm, "Lower corner", "Grid/");
+    upper     = get_point(prm, "Upper corner", "Grid/");
     cell_size = prm.get_double("Cell size");
     if (!(cell_size > 0))
       fail("Grid/Cell size", "must be > 0, got " + prm.get("Cell size") + ".");
@@ -430,7 +453,7 @@ namespace mpm
                                                                   : LocalDampingForm::per_component;
     damping_threshold = prm.get_double("Local damping threshold");
     flip_fraction     = prm.get_double("FLIP fraction");
-    gravity           = get_point(prm, "Gravity");
+    gravity           = get_point(prm, "Gravity", "Solver/");
     gravity_ramp_time = prm.get_double("Gravity ramp time");
     max_steps         = prm.get_integer("Maximum number of steps");
     max_predicted_steps = prm.get_double("Maximum predicted steps");
@@ -482,7 +505,7 @@ namespace mpm
         MaterialParameters<double> &m = materials.back();
         RandomFieldParameters       rf;
         rf.covariance         = prm.get("Covariance") == "exponential" ? Covariance::exponential : Covariance::gaussian;
-        rf.correlation_length = get_point(prm, "Correlation lengths");
+        rf.correlation_length = get_point(prm, "Correlation lengths", where);
         rf.standard_deviation = prm.get_double("Standard deviation");
         rf.seed               = prm.get_integer("Seed");
         material_field_max_clipped.push_back(prm.get_double("Maximum clipped fraction"));
@@ -588,23 +611,22 @@ namespace mpm
         prm.enter_subsection("Body " + std::to_string(b));
         BodyParameters body;
         body.shape = prm.get("Shape");
-        body.lower = get_point(prm, "Lower corner");
-        body.upper = get_point(prm, "Upper corner");
+        body.lower = get_point(prm, "Lower corner", where);
+        body.upper = get_point(prm, "Upper corner", where);
         for (const std::string &vertex :
              dealii::Utilities::split_string_list(prm.get("Polygon vertices"), ';'))
           {
-            const auto xy = dealii::Utilities::string_to_double(dealii::Utilities::split_string_list(vertex, ','));
+            const auto xy = to_doubles(where + "Polygon vertices", vertex);
             body.polygon.push_back({{xy[0], xy[1]}});
           }
         {
-          const auto axis = dealii::Utilities::string_to_double(
-            dealii::Utilities::split_string_list(prm.get("Cylinder axis"), ','));
+          const auto axis = to_doubles(where + "Cylinder axis", prm.get("Cylinder axis"));
           body.axis   = {{axis[0], axis[1]}};
           body.radius = prm.get_double("Radius");
         }
         body.points_per_direction = prm.get_integer("Points per cell direction");
         body.density              = prm.get_double("Density");
-        body.velocity             = get_point(prm, "Initial velocity");
+        body.velocity             = get_point(prm, "Initial velocity", where);
         body.material             = prm.get("Material");
         body.initial_stress       = prm.get("Initial stress");
         body.k0                   = prm.get_double("K0");

@@ -1,0 +1,150 @@
+// A Simulator's checkpoints: writing one, and resuming a run from one (doc/checkpoints.md).
+#include "simulator_state.h"
+
+namespace mpm
+{
+  template <int dim>
+  std::string Simulator<dim>::write_checkpoint()
+  {
+    AssertThrow(state->set_up, dealii::ExcMessage("Simulator::write_checkpoint() needs setup() first."));
+    return state->write_checkpoint();
+  }
+
+  template <int dim>
+  bool Simulator<dim>::stopped() const
+  {
+    return state->stopped;
+  }
+
+  namespace
+  {
+    // A checkpoint resumes the run that wrote it: the same dimension, grid and materials.
+    void check_resumable(const RunState &r, const Parameters &p, const std::string &folder)
+    {
+      const std::string of = "--resume: the checkpoint '" + folder + "' ";
+      AssertThrow(r.dim == p.dim, dealii::ExcMessage(of + "is of a " + std::to_string(r.dim) +
+                                                     "D run; the parameter file's Dimension is " +
+                                                     std::to_string(p.dim) + "."));
+      AssertThrow(r.lower == p.lower && r.upper == p.upper && r.cell_size == p.cell_size,
+                  dealii::ExcMessage(of + "was written on another grid: Grid/Lower corner, Grid/Upper corner and "
+                                          "Grid/Cell size must be those of the run that wrote it."));
+      AssertThrow(r.n_materials == p.materials.size() && r.state_variable_names == p.state_variable_names(),
+                  dealii::ExcMessage(of + "holds points of " + std::to_string(r.n_materials) +
+                                     " material(s); Materials/Names declares " + std::to_string(p.materials.size()) +
+                                     " (the materials, their order and their models must be those of the run that "
+                                     "wrote it)."));
+    }
+  } // namespace
+
+  template <int dim>
+  void Simulator<dim>::resume(const std::string &path)
+  {
+    State            &s          = *state;
+    const Parameters &parameters = s.parameters;
+    AssertThrow(!s.set_up, dealii::ExcMessage("Simulator::resume() after setup(): call one of them."));
+    const std::string folder = checkpoint::find(path);
+    const RunState    r      = checkpoint::read_state(folder);
+    check_resumable(r, parameters, folder);
+    check_backend(parameters.backend);
+    std::future<void> cuda_ready;
+    if (parameters.backend == "cuda")
+      cuda_ready = start_cuda_initialisation(s.communicator);
+
+    s.h                 = parameters.cell_size;
+    s.c_el              = r.elastic_wave_speed;
+    s.m_min             = r.smallest_point_mass;
+    s.time              = r.time;
+    s.dt                = r.dt;
+    s.max_speed         = r.max_speed;
+    s.max_removed_speed = r.max_removed_speed;
+    s.work_of_gravity   = r.work_of_gravity;
+    s.balanced          = r.balanced;
+    s.next_output       = r.next_output;
+    s.step              = r.step;
+    s.n_points_initial  = r.n_points_initial;
+    s.n_removed         = r.n_removed;
+    s.initial_mass      = r.initial_mass;
+    s.n_resorts         = r.n_resorts;
+    s.n_repartitions    = r.n_repartitions;
+    s.equilibration     = r.equilibration;
+    s.plastic           = r.plastic;
+    s.materials         = parameters.materials;
+    for (auto &m : s.materials)
+      m.plasticity_enabled = s.plastic;
+
+    s.output = std::make_unique<OutputWriter<dim>>(parameters, s.communicator, /*resuming=*/true);
+    s.output->resume({r.n_outputs, r.grid_records, r.particle_records}, r.step);
+
+    // The grid evenly partitioned; each rank reads every rank's points and keeps those in its
+    // cells (one rank: all, including those that left the grid, as the engine held them).
+    const unsigned int rank = dealii::Utilities::MPI::this_mpi_process(s.communicator);
+    s.timer.enter_subsection("setup: grid");
+    s.grid   = std::make_unique<BackgroundGrid<dim>>(parameters, s.communicator);
+    s.points = std::make_unique<MaterialPoints<dim>>(*s.grid, parameters);
+    const BackgroundGrid<dim> &grid = *s.grid;
+    const PointSnapshot<dim>   saved =
+      checkpoint::read_points<dim>(folder, r, [&](const HostPoints<dim, double> &p, const int i) {
+        if (!s.parallel)
+          return true;
+        if (p.material[i] < 0) // left the grid (saved by one rank): dropped here, counted once
+          {
+            if (rank == 0)
+              {
+                ++s.n_dropped;
+                s.dropped_mass += p.mass[i];
+              }
+            return false;
+          }
+        double x[dim];
+        for (int d = 0; d < dim; ++d)
+          x[d] = p.position[d][i];
+        return p.material[i] >= 0 && grid.owned_cell(grid.lattice_cell_of(x)) != grid.triangulation.end();
+      });
+    AssertThrow(saved.points.n_state_variables() == static_cast<int>(parameters.state_variable_names().size()),
+                dealii::ExcMessage("--resume: the points of '" + folder + "': " +
+                                   state_variable_count_mismatch(saved.points.n_state_variables(),
+                                                                 parameters.state_variable_names())));
+    if (!s.parallel)
+      s.points->replace(saved);
+    s.points->n_sent = rank == 0 ? r.n_sent : 0;
+    if (rank == 0) // the sums over ranks
+      {
+        s.n_dropped    += r.n_dropped;
+        s.dropped_mass += r.dropped_mass;
+      }
+    s.timer.leave_subsection();
+
+    s.resort_at = std::min(parameters.resort_distance * safe_distance_outside_home_cell(parameters.shape_function),
+                           s.parallel && parameters.pressure_averaging ? 0.5 : 1e300);
+    s.timer.enter_subsection("setup: engine");
+    if (cuda_ready.valid())
+      cuda_ready.get();
+    s.start_from(saved);
+    s.timer.leave_subsection();
+
+    s.print_header();
+    s.pcout << "  resumed from " << folder << " (written on " << r.n_ranks << " MPI rank(s)) at t = " << s.time
+            << " s, step " << s.step << std::endl;
+    s.apply_settings();
+    s.last_progress = s.last_checkpoint_wall = std::chrono::steady_clock::now();
+    s.last_checkpoint_step                   = s.step;
+    s.last_checkpoint                        = folder;
+    s.first_time                             = s.time;
+    s.first_step                             = s.step;
+    s.set_up                                 = true;
+    s.stepping_start                         = s.last_progress;
+  }
+
+
+  void request_checkpoint_and_stop()
+  {
+    stop_requested.store(true);
+  }
+
+  template std::string Simulator<2>::write_checkpoint();
+  template bool Simulator<2>::stopped() const;
+  template void Simulator<2>::resume(const std::string &);
+  template std::string Simulator<3>::write_checkpoint();
+  template bool Simulator<3>::stopped() const;
+  template void Simulator<3>::resume(const std::string &);
+} // namespace mpm

@@ -1,0 +1,676 @@
+// The state of a Simulator between its steps, and what its source files share
+// (source/simulator*.cc, source/instability_message.cc). Private to the library.
+#ifndef MPM_SOURCE_SIMULATOR_STATE_H
+#define MPM_SOURCE_SIMULATOR_STATE_H
+
+#include <mpm/core/migration.h>
+#include <mpm/dealii/background_grid.h>
+#include <mpm/dealii/checkpoint.h>
+#include <mpm/dealii/cuda_engine.h>
+#include <mpm/dealii/fem_state_file.h>
+#include <mpm/dealii/guards.h>
+#include <mpm/dealii/engine.h>
+#include <mpm/dealii/material_points.h>
+#include <mpm/dealii/output_writer.h>
+#include <mpm/dealii/simulator.h>
+
+#include <deal.II/base/conditional_ostream.h>
+#include <deal.II/base/mpi.h>
+#include <deal.II/base/timer.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <exception>
+#include <future>
+#include <iomanip>
+#include <iostream>
+#include <limits>
+#include <sstream>
+#include <unordered_map>
+#include <utility>
+
+namespace mpm
+{
+  using dealii::Utilities::MPI::max;
+  using dealii::Utilities::MPI::min;
+  using dealii::Utilities::MPI::sum;
+
+  namespace simulator_internal
+  {
+    // Set by request_checkpoint_and_stop (a signal handler): lock-free, so async-signal-safe.
+    inline std::atomic<bool> stop_requested{false};
+    static_assert(std::atomic<bool>::is_always_lock_free);
+
+    template <int dim>
+    inline PointTotals<dim, double> global_totals(PointTotals<dim, double> t, MPI_Comm comm)
+    {
+      t.mass           = sum(t.mass, comm);
+      t.kinetic_energy = sum(t.kinetic_energy, comm);
+      t.n_points       = sum(t.n_points, comm);
+      t.removed_mass   = sum(t.removed_mass, comm);
+      t.n_removed      = sum(t.n_removed, comm);
+      for (int d = 0; d < dim; ++d)
+        {
+          t.momentum[d] = sum(t.momentum[d], comm);
+          t.lower[d]    = min(t.lower[d], comm);
+          t.upper[d]    = max(t.upper[d], comm);
+        }
+      return t;
+    }
+
+    // Restores a stream's precision, which the summaries change, when it goes out of scope:
+    // a program may run several simulations and print on the same stream.
+    struct KeepPrecision
+    {
+      explicit KeepPrecision(std::ostream &stream)
+        : stream(stream)
+        , precision(stream.precision())
+      {}
+      ~KeepPrecision() { stream.precision(precision); }
+      std::ostream         &stream;
+      const std::streamsize precision;
+    };
+
+    // Largest elastic wave speed over the bodies, sqrt((K + 4G/3) / rho).
+    inline double elastic_wave_speed(const Parameters &p)
+    {
+      double c = 0;
+      for (unsigned int b = 0; b < p.bodies.size(); ++b)
+        c = std::max(c, std::sqrt(p.materials[p.body_material[b]].elastic.p_wave_modulus() / p.bodies[b].density));
+      return c;
+    }
+
+    // Deletes the run's TimerOutput, except while an exception unwinds the stack (an error on
+    // its way to the user): there deal.II's destructor skips the timing summary (a collective
+    // MPI call that not every rank might reach) and prints instead its seven-line banner
+    // "TimerOutput objects finalize timed values printed to the screen by communicating over
+    // MPI in their destructors..." ahead of the error's own message. The timer is then left
+    // undestroyed on purpose: it holds no resource but memory, and the error ends the run.
+    struct DeleteTimerUnlessUnwinding
+    {
+      void operator()(dealii::TimerOutput *timer) const
+      {
+        if (std::uncaught_exceptions() == 0)
+          delete timer;
+      }
+    };
+
+    // A step's largest speeds with "not a number" made infinite, so that the maximum over the
+    // ranks (MPI_MAX may drop a NaN) and the stability check see it.
+    inline StepReduction<double> nan_as_infinite(StepReduction<double> r)
+    {
+      for (double *speed : {&r.max_speed, &r.max_removed_speed})
+        if (std::isnan(*speed))
+          *speed = std::numeric_limits<double>::infinity();
+      return r;
+    }
+
+    // The message of engine_step's stability check: the point that blew up (the first whose
+    // velocity, position, stress, deformation gradient or volume is not finite, else the
+    // fastest; on several ranks the worst over the ranks, a collective call), what blew up,
+    // and the remedies that fit the scene's settings.
+    template <int dim>
+    std::string describe_instability(Engine<dim> &engine, const Parameters &p, double c_el, double dt,
+                                     double reported_speed, bool equilibrating, bool parallel,
+                                     MPI_Comm communicator);
+  } // namespace simulator_internal
+
+  using namespace simulator_internal;
+
+  // Everything a run holds between its steps. Members are destroyed in reverse order: the
+  // output (whose background tasks read the grid) before the grid, points and engine; the
+  // timer last but for the stream it prints to.
+  template <int dim>
+  struct Simulator<dim>::State
+  {
+    State(const Parameters &p, MPI_Comm comm)
+      : parameters(p)
+      , communicator(comm)
+      , n_ranks(dealii::Utilities::MPI::n_mpi_processes(comm))
+      , parallel(n_ranks > 1)
+      , pcout(std::cout, dealii::Utilities::MPI::this_mpi_process(comm) == 0)
+      , timer_owner(new dealii::TimerOutput(comm, pcout, dealii::TimerOutput::summary, dealii::TimerOutput::wall_times))
+      , timer(*timer_owner)
+      , wall_start(std::chrono::steady_clock::now())
+    {}
+
+    struct GridAndPoints
+    {
+      std::unique_ptr<BackgroundGrid<dim>> grid;
+      std::unique_ptr<MaterialPoints<dim>> points;
+      double                               seconds = 0;
+    };
+
+    const Parameters           parameters;
+    MPI_Comm                   communicator;
+    const unsigned int         n_ranks;
+    const bool                 parallel;
+    dealii::ConditionalOStream pcout;
+    std::unique_ptr<dealii::TimerOutput, DeleteTimerUnlessUnwinding> timer_owner;
+    dealii::TimerOutput                                             &timer;
+    const std::chrono::steady_clock::time_point wall_start;
+    std::chrono::steady_clock::time_point       stepping_start; // the end of setup()
+
+    double c_el = 0, h = 0;
+    std::unique_ptr<BackgroundGrid<dim>> grid;
+    std::unique_ptr<MaterialPoints<dim>> points;
+    std::unique_ptr<Engine<dim>>         engine;
+    std::unique_ptr<OutputWriter<dim>>   output;
+    std::vector<MaterialParameters<double>> materials;
+    bool                                    plastic = false;
+    StepSettings<dim, double>               settings;
+
+    long   n_points_initial = 0;
+    double m_min            = 1e300;
+    // The loss checks (check_losses): the initial mass, and on this rank the points dropped
+    // from the engine after leaving the grid (re-sorts), their number and mass; the largest
+    // relative mass balance seen.
+    double initial_mass = 0, dropped_mass = 0, worst_mass_balance = 0;
+    long   n_dropped    = 0;
+    // One rank: deal.II's grid and handler being built on a thread (see setup()).
+    std::future<GridAndPoints> grid_build;
+    const std::string          beside_grid          = "setup and first steps, beside deal.II's grid";
+    double                     engine_setup_seconds = 0;
+    bool                       initial_output_pending = false;
+
+    double resort_at = 1e300;
+    long   n_resorts = 0, n_repartitions = 0;
+    double balanced  = 1; // imbalance right after the last repartition: what p4est achieves
+
+    double time = 0, max_speed = 0, max_removed_speed = 0, work_of_gravity = 0, dt = 0, gravity_power = 0;
+    bool                equilibrating = false;
+    EquilibrationReport equilibration;
+    long   step = 0, n_removed = 0;
+    double next_output = 0;
+    std::chrono::steady_clock::time_point last_progress;
+    bool set_up = false, finished_run = false;
+
+    // Checkpoints: when the last was written (wall clock, step), and what was asked for after
+    // the last step, agreed by every rank: 0 nothing, 1 a checkpoint (wall clock due), 2 a
+    // checkpoint and a stop (request_checkpoint_and_stop).
+    std::chrono::steady_clock::time_point last_checkpoint_wall;
+    long                                  last_checkpoint_step = -1;
+    std::string                           last_checkpoint;
+    int                                   request = 0;
+    bool                                  stopped = false;
+    // Where this process started stepping (a resumed run: the checkpoint's time and step),
+    // for its rates and ETA.
+    double first_time = 0;
+    long   first_step = 0;
+
+    // What this rank asks for after the current step (request): 2 stop, 1 a checkpoint.
+    int local_request() const
+    {
+      if (stop_requested.load())
+        return 2;
+      const double minutes =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - last_checkpoint_wall).count() / 60;
+      return parameters.checkpoint_wall_interval > 0 && minutes >= parameters.checkpoint_wall_interval ? 1 : 0;
+    }
+
+    // Reductions over the ranks; on one rank the value itself, without an MPI call.
+    double global_max(const double x) const { return parallel ? max(x, communicator) : x; }
+    double global_min(const double x) const { return parallel ? min(x, communicator) : x; }
+    double global_sum(const double x) const { return parallel ? sum(x, communicator) : x; }
+
+    // A TimerOutput section, except while the grid thread runs (then the time counts to
+    // the section entered before it started).
+    template <typename Work>
+    auto timed(const char *section, Work &&work)
+    {
+      if (grid_build.valid())
+        return work();
+      dealii::TimerOutput::Scope scope(timer, section);
+      return work();
+    }
+
+    // Joins the grid thread (waits for it where it is still running): from here on the
+    // grid and the handler exist and MPI may be called again.
+    void join_grid()
+    {
+      if (!grid_build.valid())
+        return;
+      GridAndPoints built = grid_build.get();
+      grid                = std::move(built.grid);
+      points              = std::move(built.points);
+      timer.leave_subsection(beside_grid);
+      pcout << "  deal.II's grid and ParticleHandler built on a thread in " << built.seconds
+            << " s, beside the engine's set-up (" << engine_setup_seconds << " s) and the first " << step
+            << " steps" << std::endl;
+      if (initial_output_pending)
+        {
+          dealii::TimerOutput::Scope scope(timer, "output");
+          output->write_fields(0, *grid); // before the first step every nodal field is zero
+          initial_output_pending = false;
+        }
+    }
+
+    // Max/mean work per rank; the engine knows its points where it re-sorts them itself.
+    double imbalance() const
+    {
+      return engine ? points->imbalance(static_cast<double>(engine->n_points())) : points->imbalance();
+    }
+
+    // Repartition when the work per rank is out of balance by more than the threshold and
+    // by clearly more than the last repartition could reach (no futile repeats when the
+    // granularity of cells forbids better). Points per rank only change at re-sorts, so
+    // this is checked at the start and after each re-sort.
+    bool balance()
+    {
+      if (!parallel || !(parameters.load_balance_threshold > 0))
+        return false;
+      const double before = imbalance();
+      if (before <= parameters.load_balance_threshold ||
+          before <= balanced + 0.5 * (parameters.load_balance_threshold - 1))
+        return false;
+      dealii::TimerOutput::Scope scope(timer, "repartition");
+      output->finish(); // a grid output in flight reads the DoFHandler
+      if (engine)
+        engine->sync(*points); // the handler's points move with their cells
+      points->repartition();
+      ++n_repartitions;
+      balanced = points->imbalance();
+      pcout << "  repartitioned the grid by work: max/mean work per rank " << before << " -> " << balanced
+            << std::endl;
+      return true;
+    }
+
+    // Plastic models answer elastically until Solver/Plasticity start time.
+    void switch_plasticity_on_when_due()
+    {
+      if (plastic || time < parameters.plasticity_start_time)
+        return;
+      plastic = true;
+      for (auto &m : materials)
+        m.plasticity_enabled = true;
+      engine->set_materials(materials);
+      pcout << "  plasticity switched on at t = " << time << " s" << std::endl;
+    }
+
+    // One step of the engine with the current settings, and what every step needs after it:
+    // the largest speeds over the ranks, the MPI re-sort when points have strayed, the
+    // stability check. Time and step counters are the caller's.
+    void engine_step(const double dt)
+    {
+      const StepReduction<double> r = nan_as_infinite(timed("MPM step", [&]() { return engine->step(settings, dt); }));
+      gravity_power     = r.gravity_power;
+      max_speed         = r.max_speed;
+      max_removed_speed = r.max_removed_speed;
+      // Where a message says the step was; built only for a message (a string per step costs).
+      const auto when = [&]() {
+        return equilibrating ?
+                 "in damped step " + std::to_string(equilibration.steps + 1) + " of the equilibration" :
+                 "at t = " + dealii::Utilities::to_string(time + dt) + " s (step " + std::to_string(step + 1) + ")";
+      };
+      if (parallel)
+        {
+          // One reduction for the next time step and the migration test: the largest
+          // speed and the largest distance of a point outside its home cell.
+          // And what the ranks ask for after the step (a checkpoint, a stop).
+          double local[4] = {r.max_speed, engine->max_distance_outside_home_cells(), r.max_removed_speed,
+                             double(local_request())},
+                 global[4];
+          dealii::Utilities::MPI::max(dealii::ArrayView<const double>(local, 4), communicator,
+                                      dealii::ArrayView<double>(global, 4));
+          max_speed         = global[0];
+          max_removed_speed = global[2];
+          request           = static_cast<int>(global[3]);
+          AssertThrow(!parameters.pressure_averaging || global[1] < 1,
+                      dealii::ExcMessage("Parameter 'Solver/Pressure averaging': " + when() + " a point moved to " +
+                                         dealii::Utilities::to_string(global[1]) +
+                                         " cells outside the cell it was sorted into, beyond the ghost cells "
+                                         "whose pressure sums are exchanged between ranks. Reduce 'Solver/CFL "
+                                         "number' or the time step."));
+          if (global[1] >= resort_at)
+            {
+              {
+                dealii::TimerOutput::Scope scope(timer, "migrate points");
+                resort();
+              }
+              if (balance())
+                engine->load(*points);
+            }
+        }
+      // A blow-up shows as a non-finite velocity or, with the adaptive step, as speeds that
+      // shrink dt by orders of magnitude: stop with a message instead of crawling on.
+      // (Every rank decides alike: the speeds are the maxima over the ranks.)
+      const double fastest = std::max(max_speed, max_removed_speed);
+      if (!(std::isfinite(fastest) && fastest <= 1000 * c_el))
+        AssertThrow(false, dealii::ExcMessage("The simulation became unstable " + when() + " (a speed above 1000 "
+                                              "times the elastic wave speed, or not finite): " +
+                                              describe_instability<dim>(*engine, parameters, c_el, dt, fastest,
+                                                                        equilibrating, parallel, communicator)));
+    }
+
+    // Initial state/Equilibrate: damped steps at t = 0 with gravity in full until the points
+    // rest in the MPM's own equilibrium of the state given (time and step stay 0).
+    void equilibrate()
+    {
+      const auto started = std::chrono::steady_clock::now();
+      switch_plasticity_on_when_due(); // the materials as the first step will have them
+      for (int d = 0; d < dim; ++d)
+        settings.gravity[d] = parameters.gravity[d];
+
+      PointSnapshot<dim> before;
+      engine->snapshot(before);
+      const HostPoints<dim, double> &p0 = before.points;
+      // The reference speed sqrt(|g| H), H the extent of the points' domains along gravity.
+      double g = 0;
+      for (int d = 0; d < dim; ++d)
+        g += parameters.gravity[d] * parameters.gravity[d];
+      g = std::sqrt(g);
+      double lowest = 1e300, highest = -1e300, smallest_domain = h;
+      for (int i = 0; i < p0.size(); ++i)
+        if (p0.material[i] >= 0)
+          for (int d = 0; d < dim; ++d)
+            smallest_domain = std::min(smallest_domain, p0.domain_half_length[d][i]);
+      for (int i = 0; i < p0.size(); ++i)
+        if (p0.material[i] >= 0 && g > 0)
+          {
+            double along = 0, reach = 0;
+            for (int d = 0; d < dim; ++d)
+              {
+                along += p0.position[d][i] * parameters.gravity[d] / g;
+                reach += p0.domain_half_length[d][i] * std::abs(parameters.gravity[d]) / g;
+              }
+            lowest  = std::min(lowest, along - reach);
+            highest = std::max(highest, along + reach);
+          }
+      const double extent = g > 0 ? global_max(highest) + global_max(-lowest) : 0;
+      equilibration.reference_speed = g > 0 ? std::sqrt(g * extent) : c_el;
+      const double transit = (g > 0 ? extent : h) / c_el;
+
+      // Damped, PIC (FLIP would keep velocities the grid does not see, undamped for ever), and
+      // the points held in place: the equilibrium of the geometry given, not of one the points
+      // creep into (at a free surface a point whose domain just reaches a node's support feels
+      // that light node's large acceleration, and drifts).
+      //
+      // With GIMP the grid keeps its velocities between the steps (a dynamic relaxation on
+      // the grid); rebuilt from the points, the light nodes at a free surface relax over
+      // thousands of steps and leave forces that FLIP then turns into creeping point
+      // velocities (doc/log.md). A light node whose points reach it with the tail of a
+      // domain of half-length l has a stiffness over mass of up to c^2 sum_d 1/(l_d h),
+      // so the step is cut to a Courant number of sqrt(l_min / (dim h)) (at most the
+      // run's): omega dt <= 1 for the stiffest such node. Linear shape functions give no
+      // such bound (a point close to a node line makes the node's ratio unbounded): there
+      // the velocities are rebuilt from the points, which is stable, and slower.
+      const bool   on_grid = parameters.shape_function == ShapeFunction::gimp;
+      const double courant = on_grid ? std::sqrt(global_min(smallest_domain) / (dim * h)) : 1e300;
+      const double damping = settings.damping, flip_fraction = settings.flip_fraction;
+      settings.damping       = parameters.equilibration_damping;
+      settings.flip_fraction = 0;
+      settings.hold_points   = true;
+      equilibrating          = true;
+      double calm            = 0; // how long the points have been at rest
+      while (calm < transit)
+        {
+          AssertThrow(equilibration.steps < long(parameters.equilibration_maximum_steps),
+                      dealii::ExcMessage(
+                        "Parameter 'Initial state/Equilibration maximum steps': after " +
+                        std::to_string(equilibration.steps) + " damped steps the largest point speed is still " +
+                        dealii::Utilities::to_string(max_speed / equilibration.reference_speed) +
+                        " sqrt(|g| H), above 'Initial state/Equilibration tolerance' (" +
+                        dealii::Utilities::to_string(parameters.equilibration_tolerance) +
+                        "). Either the state is not stable under these materials (it fails under its own "
+                        "weight), or it needs more steps: raise the maximum or the tolerance."));
+          const double dt = parameters.adaptive_time_step ?
+                              std::min(parameters.cfl, courant) * h / (c_el + max_speed) :
+                              std::min(parameters.fixed_time_step, courant * h / c_el);
+          settings.hold_from_point_momentum = !on_grid || equilibration.steps == 0;
+          engine_step(dt);
+          ++equilibration.steps;
+          calm = max_speed < parameters.equilibration_tolerance * equilibration.reference_speed ? calm + dt : 0;
+        }
+      equilibrating             = false;
+      settings.damping          = damping;
+      settings.flip_fraction    = flip_fraction;
+      settings.hold_points      = false;
+      equilibration.final_speed = max_speed;
+
+      // How far it moved the stresses, point by point (by id: the engine may reorder them).
+      PointSnapshot<dim> after;
+      engine->snapshot(after);
+      std::unordered_map<dealii::types::particle_index, int> index;
+      for (int i = 0; i < p0.size(); ++i)
+        if (p0.material[i] >= 0)
+          index[before.labels->id[i]] = i;
+      const HostPoints<dim, double> &p1 = after.points;
+      double largest = 0, squares = 0, compared = 0;
+      for (int i = 0; i < p1.size(); ++i)
+        {
+          const auto found = index.find(after.labels->id[i]);
+          if (p1.material[i] < 0 || found == index.end())
+            continue;
+          const int j = found->second;
+          double change = 0;
+          for (int c = 0; c < n_voigt; ++c)
+            change = std::max(change, std::abs(p1.stress[c][i] - p0.stress[c][j]));
+          largest = std::max(largest, change);
+          squares += change * change;
+          compared += 1;
+        }
+      equilibration.max_stress_change = global_max(largest);
+      equilibration.rms_stress_change = std::sqrt(global_sum(squares) / std::max(1.0, global_sum(compared)));
+      equilibration.wall_seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+      pcout << "  equilibration: " << equilibration.steps << " damped steps (D = "
+            << parameters.equilibration_damping << ") in " << equilibration.wall_seconds
+            << " s; largest point speed at rest " << equilibration.final_speed << " m/s ("
+            << equilibration.final_speed / equilibration.reference_speed
+            << " sqrt(|g| H)); the stresses changed by up to " << equilibration.max_stress_change << " Pa (r.m.s. "
+            << equilibration.rms_stress_change << " Pa)" << std::endl;
+    }
+
+    // The step's settings from the prm (gravity is set by each step, from the ramp).
+    void apply_settings()
+    {
+      settings.scheme             = parameters.scheme;
+      settings.damping            = parameters.damping;
+      settings.damping_form       = parameters.damping_form;
+      settings.damping_threshold  = parameters.damping_threshold;
+      settings.flip_fraction      = parameters.flip_fraction;
+      settings.domain_update      = parameters.domain_update;
+      settings.pressure_averaging = parameters.pressure_averaging;
+      settings.mass_tolerance     = 1e-12 * m_min; // nodes lighter than that carry no velocity
+    }
+
+    void print_header()
+    {
+      const HostGrid<dim, double> lattice = lattice_geometry<dim>(parameters);
+      long                        n_cells = 1, n_nodes = 1;
+      for (int d = 0; d < dim; ++d)
+        {
+          n_cells *= lattice.n_cells[d];
+          n_nodes *= lattice.n_cells[d] + 1;
+        }
+      pcout << "dealii-mpm: " << dim << "D, " << n_cells << " cells, " << n_nodes << " nodes, " << n_points_initial
+            << " material points, " << n_ranks << " MPI rank(s), backend " << parameters.backend << "\n"
+            << "  elastic wave speed " << c_el << " m/s, end time " << parameters.end_time << " s, output in '"
+            << output->directory() << "'" << std::endl;
+    }
+
+    // Everything of the run but its points and grid, for a checkpoint (collective: the
+    // points handed between ranks are summed).
+    RunState run_state() const
+    {
+      RunState r;
+      r.dim                  = dim;
+      r.n_ranks              = n_ranks;
+      r.lower                = parameters.lower;
+      r.upper                = parameters.upper;
+      r.cell_size            = parameters.cell_size;
+      r.n_materials          = parameters.materials.size();
+      r.state_variable_names = parameters.state_variable_names();
+      r.time                 = time;
+      r.dt                   = dt;
+      r.max_speed            = max_speed;
+      r.max_removed_speed    = max_removed_speed;
+      r.work_of_gravity      = work_of_gravity;
+      r.elastic_wave_speed   = c_el;
+      r.smallest_point_mass  = m_min;
+      r.balanced             = balanced;
+      r.next_output          = next_output;
+      r.step                 = step;
+      r.n_points_initial     = n_points_initial;
+      r.n_removed            = n_removed;
+      r.initial_mass         = initial_mass;
+      r.n_dropped            = parallel ? static_cast<long>(sum(double(n_dropped), communicator)) : n_dropped;
+      r.dropped_mass         = parallel ? sum(dropped_mass, communicator) : dropped_mass;
+      r.n_resorts            = n_resorts;
+      r.n_repartitions       = n_repartitions;
+      r.n_sent               = parallel ? static_cast<long>(sum(double(points->n_sent), communicator)) : 0;
+      r.plastic              = plastic;
+      r.equilibration        = equilibration;
+      const auto records     = output->records();
+      r.n_outputs            = records.n_outputs;
+      r.grid_records         = records.grid;
+      r.particle_records     = records.particles;
+      return r;
+    }
+
+    // Several ranks: the partition of the grid by the points' work as it is now (where the
+    // run repartitions at all). A pure function of the points' cells, whichever partition the
+    // grid had before: a run resumed on an even partition comes to the same one.
+    void partition_by_current_work()
+    {
+      if (!parallel || !(parameters.load_balance_threshold > 0))
+        return;
+      output->finish(); // a grid output in flight reads the DoFHandler
+      points->repartition();
+      ++n_repartitions;
+      balanced = points->imbalance();
+    }
+
+    // A checkpoint of the run after the current step. Then the engine starts anew from the
+    // saved points exactly as a run resumed from the checkpoint does (on several ranks: the
+    // handler filled with them, the grid partitioned by their work, the engine loaded from
+    // the handler; on one: the engine loaded with them, forgetting what it built for the
+    // points before, the CPU's scatter slabs): the resumed run is bit-identical to this one.
+    std::string write_checkpoint()
+    {
+      join_grid();
+      dealii::TimerOutput::Scope scope(timer, "checkpoint");
+      const auto                 started = std::chrono::steady_clock::now();
+      PointSnapshot<dim>         snapshot;
+      if (parallel)
+        {
+          resort(); // every point on the rank owning its cell
+        }
+      engine->snapshot(snapshot);
+      last_checkpoint = checkpoint::write<dim>(parameters.checkpoint_directory, run_state(), snapshot,
+                                               parameters.checkpoint_keep, communicator);
+      start_from(snapshot);
+      last_checkpoint_wall = std::chrono::steady_clock::now();
+      last_checkpoint_step = step;
+      pcout << "  checkpoint at t = " << time << " s (step " << step << "): " << last_checkpoint << " ("
+            << std::chrono::duration<double>(last_checkpoint_wall - started).count() << " s)" << std::endl;
+      return last_checkpoint;
+    }
+
+    // The engine (made where there is none yet) starts from `saved`: a checkpoint's points,
+    // all of this rank's (one rank) or those in its cells (several).
+    void start_from(const PointSnapshot<dim> &saved)
+    {
+      if (parallel)
+        {
+          points->replace(saved);
+          partition_by_current_work();
+          if (!engine)
+            engine = make_engine<dim>(parameters.backend, *grid, materials, parameters.shape_function);
+          engine->load(*points);
+        }
+      else
+        {
+          if (!engine)
+            engine = make_engine<dim>(parameters.backend, lattice_grid<dim>(parameters), materials,
+                                      parameters.shape_function);
+          engine->load(saved.points, saved.labels); // in the saved order: the same sums as before
+        }
+      engine->set_sort_interval(parameters.sort_interval);
+    }
+
+    // The MPI re-sort, counting the points it drops (those that left the grid): they must be
+    // the ones the engine held as removed.
+    void resort()
+    {
+      const PointTotals<dim, double> held    = engine->totals();
+      const unsigned int             dropped = engine->resort(*points);
+      AssertThrow(static_cast<long>(dropped) == held.n_removed,
+                  dealii::ExcMessage("Internal error (loss check): a re-sort dropped " + std::to_string(dropped) +
+                                     " points, but " + std::to_string(held.n_removed) +
+                                     " had left the grid on this rank."));
+      n_dropped += held.n_removed;
+      dropped_mass += held.removed_mass;
+      ++n_resorts;
+    }
+
+    // Points are never made or lost but by leaving the grid: the points in the grid and those
+    // removed make the initial number exactly, and their masses the initial mass to round-off
+    // (1e-9: the sums' order differs). Throws where either fails: a bug, not a bad input.
+    // Returns (removed mass, relative mass balance).
+    std::pair<double, double> check_losses(const PointTotals<dim, double> &totals)
+    {
+      double       local[2] = {double(n_dropped), dropped_mass}, global[2] = {local[0], local[1]};
+      if (parallel)
+        dealii::Utilities::MPI::sum(dealii::ArrayView<const double>(local, 2), communicator,
+                                    dealii::ArrayView<double>(global, 2));
+      const long   removed      = totals.n_removed + static_cast<long>(global[0]);
+      const double removed_mass = totals.removed_mass + global[1];
+      const double balance      = (totals.mass + removed_mass - initial_mass) / initial_mass;
+      n_removed                 = removed;
+      worst_mass_balance        = std::max(worst_mass_balance, std::abs(balance));
+      const std::string when    = " at t = " + dealii::Utilities::to_string(time) + " s (step " + std::to_string(step) + ")";
+      AssertThrow(totals.n_points + removed == n_points_initial,
+                  dealii::ExcMessage("Internal error (loss check)" + when + ": " + std::to_string(totals.n_points) +
+                                     " material points in the grid and " + std::to_string(removed) +
+                                     " removed make " + std::to_string(totals.n_points + removed) + ", not the " +
+                                     std::to_string(n_points_initial) + " the run started with."));
+      AssertThrow(std::abs(balance) <= 1e-9,
+                  dealii::ExcMessage("Internal error (loss check)" + when + ": the mass in the grid (" +
+                                     dealii::Utilities::to_string(totals.mass) + " kg) and the mass removed (" +
+                                     dealii::Utilities::to_string(removed_mass) + " kg) differ from the initial " +
+                                     dealii::Utilities::to_string(initial_mass) + " kg by a relative " +
+                                     dealii::Utilities::to_string(balance) + ", beyond round-off (1e-9)."));
+      return {removed_mass, balance};
+    }
+
+    void record_history()
+    {
+      timed("history", [&]() {
+        const auto local  = engine->totals();
+        const auto totals = parallel ? global_totals<dim>(local, communicator) : local;
+        const auto [removed_mass, balance] = check_losses(totals);
+        typename OutputWriter<dim>::HistoryRow row{time, dt, work_of_gravity, step, n_removed, totals};
+        row.removed_mass = removed_mass;
+        row.mass_balance = balance;
+        row.min_points_per_rank = static_cast<long>(global_min(double(local.n_points)));
+        row.max_points_per_rank = static_cast<long>(global_max(double(local.n_points)));
+        row.n_resorts           = n_resorts;
+        row.n_repartitions      = n_repartitions;
+        row.n_sent              = parallel ? static_cast<long>(sum(double(points->n_sent), communicator)) : 0;
+        output->write_history(row);
+      });
+    }
+
+    // Output reads a snapshot of the engine's points: no hand-over to the handler, which
+    // is brought up to date only where it is needed (re-sorts, repartitions).
+    void write_output()
+    {
+      if (time == 0 && grid_build.valid())
+        {
+          engine->snapshot(output->next_snapshot());
+          initial_output_pending = true;
+          return;
+        }
+      join_grid();
+      dealii::TimerOutput::Scope scope(timer, "output");
+      engine->snapshot(output->next_snapshot());
+      engine->nodal_to(*grid);
+      output->write_fields(time, *grid);
+    }
+  };
+} // namespace mpm
+
+#endif
