@@ -51,6 +51,7 @@ namespace
     int              block = 128;
     bool             drucker_prager = true;
     int              sort_every     = 20;
+    ShapeFunction    shape          = ShapeFunction::gimp;
   };
 
   // Reorder every point array by perm (new point i is old point perm[i]).
@@ -202,7 +203,10 @@ namespace
     auto sort_if_due = [&](const long step) {
       if (opt.sort_every > 0 && step % opt.sort_every == 0)
         {
-          order.template sort<GimpShape>(backend, gv, dpoints);
+          if (opt.shape == ShapeFunction::linear)
+            order.template sort<LinearShape>(backend, gv, dpoints);
+          else // GIMP and the B-spline share the stencil's first node
+            order.template sort<GimpShape>(backend, gv, dpoints);
           pv = dpoints.view();
         }
     };
@@ -217,7 +221,7 @@ namespace
           sort_if_due(i);
           const double dt = P1::cfl * P1::h / (c + max_speed);
           mpm_bench::p1_gravity(s, t);
-          max_speed = explicit_step<3, GimpShape>(backend, gv, pv, dmaterials.data(), s, Real(dt)).max_speed;
+          max_speed = explicit_step<3>(backend, opt.shape, gv, pv, dmaterials.data(), s, Real(dt)).max_speed;
           t += dt;
         }
       dgrid.upload(grid);
@@ -239,7 +243,7 @@ namespace
         sort_if_due(steps);
         const double dt = P1::cfl * P1::h / (c + max_speed);
         mpm_bench::p1_gravity(s, t);
-        max_speed = explicit_step<3, GimpShape>(backend, gv, pv, dmaterials.data(), s, Real(dt)).max_speed;
+        max_speed = explicit_step<3>(backend, opt.shape, gv, pv, dmaterials.data(), s, Real(dt)).max_speed;
         t += dt;
         ++steps;
       }
@@ -277,6 +281,7 @@ namespace
     if (opt.block != 128)
       label += ", block " + std::to_string(opt.block);
     label += opt.drucker_prager ? ", DP" : ", elastic";
+    label += opt.shape == ShapeFunction::linear ? ", linear" : opt.shape == ShapeFunction::bspline2 ? ", B-spline" : "";
     label += opt.sort_every > 0 ? ", sorted every " + std::to_string(opt.sort_every) : ", unsorted";
     const double updates  = double(n_points) * steps / wall;
     const double bytes    = minimal_bytes_per_step<Real>(n_points, n_nodes);
@@ -306,7 +311,7 @@ namespace
         for (int i = 0; i < n_prof; ++i)
           {
             const double dt = P1::cfl * P1::h / (c + max_speed);
-            max_speed = explicit_step<3, GimpShape>(backend, gv, pv, dmaterials.data(), s, Real(dt)).max_speed;
+            max_speed = explicit_step<3>(backend, opt.shape, gv, pv, dmaterials.data(), s, Real(dt)).max_speed;
             const std::vector<float> times = backend.kernel_times_ms();
             for (size_t k = 0; k < times.size() && k < sum.size(); ++k)
               sum[k] += times[k];
@@ -360,6 +365,16 @@ int main(int argc, char **argv)
         }
       else if (a == "--sort-every" && i + 1 < argc)
         opt.sort_every = std::atoi(argv[++i]);
+      else if (a == "--shape" && i + 1 < argc)
+        {
+          const std::string m = argv[++i];
+          if (m != "gimp" && m != "linear" && m != "bspline2")
+            {
+              std::printf("--shape: expected gimp, linear or bspline2, got %s\n", m.c_str());
+              return 2;
+            }
+          opt.shape = m == "gimp" ? ShapeFunction::gimp : m == "linear" ? ShapeFunction::linear : ShapeFunction::bspline2;
+        }
       else if (a == "--block" && i + 1 < argc)
         opt.block = std::atoi(argv[++i]);
       else if (a == "--table" && i + 1 < argc)
@@ -379,7 +394,8 @@ int main(int argc, char **argv)
       else
         {
           std::printf("usage: %s [--fp32] [--sizes 20,160,640,2560] [--steps N] [--profile] [--table FILE]\n"
-                      "          [--order generated|cell|random] [--block N] [--material dp|elastic] [--sort-every N]\n",
+                      "          [--order generated|cell|random] [--block N] [--material dp|elastic] [--sort-every N]\n"
+                      "          [--shape gimp|linear|bspline2]\n",
                       argv[0]);
           return 2;
         }

@@ -135,8 +135,10 @@ namespace mpm
     prm.declare_entry("End time", "1", Patterns::Double(0), "Simulated end time (s).");
     prm.declare_entry("Update scheme", "MUSL", Patterns::Selection("MUSL|USL|USF"),
                       "Explicit update scheme: MUSL (modified update stress last, default), USL or USF.");
-    prm.declare_entry("Shape function", "GIMP", Patterns::Selection("linear|GIMP"),
-                      "Grid shape functions: linear (standard MPM) or GIMP (generalised interpolation).");
+    prm.declare_entry("Shape function", "GIMP", Patterns::Selection("linear|GIMP|quadratic B-spline"),
+                      "Grid shape functions: linear (standard MPM), GIMP (generalised interpolation) or "
+                      "quadratic B-spline (C1, three nodes per direction; within half a cell of the grid's "
+                      "faces it becomes linear, doc/theory.md).");
     prm.declare_entry("GIMP domain update", "none", Patterns::Selection("none|det F|F_ii"),
                       "How GIMP particle domains follow the deformation: none (uGIMP), det F (cpGIMP, "
                       "half-lengths scaled by det(F)^(1/dim)) or F_ii (cpGIMP, half-length i scaled by F_ii; exact "
@@ -433,12 +435,14 @@ namespace mpm
     end_time = prm.get_double("End time");
     const std::string s = prm.get("Update scheme");
     scheme = s == "USL" ? UpdateScheme::usl : (s == "USF" ? UpdateScheme::usf : UpdateScheme::musl);
-    shape_function = prm.get("Shape function") == "GIMP" ? ShapeFunction::gimp : ShapeFunction::linear;
+    const std::string shape = prm.get("Shape function");
+    shape_function = shape == "GIMP" ? ShapeFunction::gimp :
+                     shape == "quadratic B-spline" ? ShapeFunction::bspline2 : ShapeFunction::linear;
     const std::string du = prm.get("GIMP domain update");
     domain_update = du == "det F" ? DomainUpdate::det_F : (du == "F_ii" ? DomainUpdate::stretch : DomainUpdate::none);
-    if (shape_function == ShapeFunction::linear && domain_update != DomainUpdate::none)
-      fail("Solver/GIMP domain update", "'" + du + "' needs Shape function = GIMP; with linear shape functions "
-                                        "the only allowed value is none.");
+    if (shape_function != ShapeFunction::gimp && domain_update != DomainUpdate::none)
+      fail("Solver/GIMP domain update", "'" + du + "' needs Shape function = GIMP; with Shape function = " + shape +
+                                        " the only allowed value is none.");
     adaptive_time_step = prm.get("Time step") == "adaptive";
     cfl                = prm.get_double("CFL number");
     if (!(cfl > 0))

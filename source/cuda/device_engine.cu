@@ -420,6 +420,8 @@ namespace mpm
         {
           if (impl->shape == ShapeFunction::gimp)
             impl->order.template sort<GimpShape>(impl->backend, g, impl->points);
+          else if (impl->shape == ShapeFunction::bspline2)
+            impl->order.template sort<QuadraticBSplineShape>(impl->backend, g, impl->points);
           else
             impl->order.template sort<LinearShape>(impl->backend, g, impl->points);
         }

@@ -8,8 +8,14 @@ int main(int argc, char **argv)
 {
   const bool explore = argc > 1 && std::strcmp(argv[1], "--explore") == 0;
   if (explore)
-    mpm_test::check_column_convergence<mpm_test::CpuTarget>({2, 4, 8, 16, 32, 64, 128, 256}, false);
+    {
+      mpm_test::check_column_convergence<mpm_test::CpuTarget>({2, 4, 8, 16, 32, 64, 128, 256}, false);
+      mpm_test::check_bspline_column<mpm_test::CpuTarget>({2, 4, 8, 16, 32, 64, 128, 256}, false);
+    }
   else
-    mpm_test::check_column_convergence<mpm_test::CpuTarget>({16, 32, 64}, true);
+    {
+      mpm_test::check_column_convergence<mpm_test::CpuTarget>({16, 32, 64}, true);
+      mpm_test::check_bspline_column<mpm_test::CpuTarget>({16, 32, 64}, true);
+    }
   return mpm_test::finish("test_elastic_column");
 }

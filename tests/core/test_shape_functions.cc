@@ -1,5 +1,7 @@
-// Partition of unity, zero gradient sum, and gradients equal to the derivative of the
-// weights (finite differences), for linear and GIMP stencils at random points, 2D and 3D.
+// Partition of unity, linear fields reproduced (weights and gradients), and gradients equal
+// to the derivative of the weights (finite differences), for the linear, GIMP and quadratic
+// B-spline stencils at random points, 2D and 3D. The B-spline is checked over the whole grid,
+// its folded boundary half-cells included (GIMP's domains inside the grid).
 #include <mpm/core/host_storage.h>
 #include <mpm/core/interpolation.h>
 #include <mpm/core/shape_functions.h>
@@ -12,7 +14,7 @@
 using namespace mpm;
 
 template <int dim, typename Shape>
-void check_family(const char *name, std::mt19937 &rng)
+void check_family(const char *name, std::mt19937 &rng, const bool whole_grid = false)
 {
   HostGrid<dim, double> grid;
   const double          lower[3] = {-1.0, 0.5, 2.0};
@@ -21,7 +23,8 @@ void check_family(const char *name, std::mt19937 &rng)
   const GridView<dim, double> g = grid.view();
 
   std::uniform_real_distribution<double> u(0.0, 1.0);
-  double worst_sum = 0, worst_grad = 0, worst_fd = 0;
+  double worst_sum = 0, worst_grad = 0, worst_fd = 0, worst_linear = 0, worst_linear_grad = 0;
+  int    near_face = 0;
   for (int trial = 0; trial < 2000; ++trial)
     {
       double x[dim], lp[dim];
@@ -29,12 +32,28 @@ void check_family(const char *name, std::mt19937 &rng)
         {
           lp[d] = (0.01 + 0.49 * u(rng)) * g.h;
           // keep the particle domain inside the grid, so no weight falls outside it
-          x[d] = g.origin[d] + lp[d] + u(rng) * (g.n_cells[d] * g.h - 2 * lp[d]);
+          x[d] = whole_grid ? g.origin[d] + u(rng) * g.n_cells[d] * g.h :
+                              g.origin[d] + lp[d] + u(rng) * (g.n_cells[d] * g.h - 2 * lp[d]);
+          // one in four trials within half a cell of a face, where the B-spline folds
+          if (whole_grid && trial % 4 == 0 && d == trial / 4 % dim)
+            x[d] = trial % 8 == 0 ? g.origin[d] + 0.5 * u(rng) * g.h : g.origin[d] + (g.n_cells[d] - 0.5 * u(rng)) * g.h;
+          const double s = (x[d] - g.origin[d]) / g.h;
+          near_face += s < 0.5 || s > g.n_cells[d] - 0.5;
         }
       double sum = 0, grad_sum[dim] = {};
+      double moment[dim] = {}, moment_grad[dim][dim] = {}; // sum N x_n, sum x_n grad N
       std::vector<double> weight(g.n_nodes, 0.0), gradient(g.n_nodes * dim, 0.0);
       for_each_stencil_node<dim, Shape>(g, x, lp, [&](int n, double N, const double *grad) {
         sum += N;
+        int rest = n;
+        for (int d = 0; d < dim; ++d)
+          {
+            const double x_n = g.origin[d] + (rest % (g.n_cells[d] + 1)) * g.h;
+            rest /= g.n_cells[d] + 1;
+            moment[d] += N * x_n;
+            for (int e = 0; e < dim; ++e)
+              moment_grad[d][e] += x_n * grad[e];
+          }
         weight[n] = N;
         for (int d = 0; d < dim; ++d)
           {
@@ -45,7 +64,12 @@ void check_family(const char *name, std::mt19937 &rng)
       });
       worst_sum = std::max(worst_sum, std::abs(sum - 1.0));
       for (int d = 0; d < dim; ++d)
-        worst_grad = std::max(worst_grad, std::abs(grad_sum[d]) * g.h);
+        {
+          worst_grad   = std::max(worst_grad, std::abs(grad_sum[d]) * g.h);
+          worst_linear = std::max(worst_linear, std::abs(moment[d] - x[d]) / g.h);
+          for (int e = 0; e < dim; ++e)
+            worst_linear_grad = std::max(worst_linear_grad, std::abs(moment_grad[d][e] - (d == e ? 1.0 : 0.0)));
+        }
 
       // central differences of the weights along each direction
       const double eps = 1e-6 * g.h;
@@ -73,10 +97,13 @@ void check_family(const char *name, std::mt19937 &rng)
             }
         }
     }
-  std::printf("%s %dD: max |sum N - 1| = %.2e, max |sum grad N| h = %.2e, max gradient vs FD = %.2e\n", name,
-              dim, worst_sum, worst_grad, worst_fd);
+  std::printf("%s %dD: max |sum N - 1| = %.2e, max |sum grad N| h = %.2e, max |sum N x_n - x| / h = %.2e, "
+              "max |sum x_n grad N - I| = %.2e, max gradient vs FD = %.2e (%d coordinates within h/2 of a face)\n",
+              name, dim, worst_sum, worst_grad, worst_linear, worst_linear_grad, worst_fd, near_face);
   mpm_test::check_below(worst_sum, 1e-14, "partition of unity");
   mpm_test::check_below(worst_grad, 1e-13, "gradients sum to zero");
+  mpm_test::check_below(worst_linear, 1e-12, "linear fields reproduced");
+  mpm_test::check_below(worst_linear_grad, 1e-12, "gradients of linear fields reproduced");
   mpm_test::check_below(worst_fd, 1e-6, "gradient equals derivative of the weight");
 }
 
@@ -87,6 +114,8 @@ int main()
   check_family<3, LinearShape>("linear", rng);
   check_family<2, GimpShape>("GIMP", rng);
   check_family<3, GimpShape>("GIMP", rng);
+  check_family<2, QuadraticBSplineShape>("quadratic B-spline", rng, true);
+  check_family<3, QuadraticBSplineShape>("quadratic B-spline", rng, true);
 
   // GIMP tends to the linear hat as the particle domain shrinks.
   double w_lin[2], dw_lin[2], w_g[3], dw_g[3];
@@ -94,5 +123,22 @@ int main()
   LinearShape::weights_1d(3.3, 0.0, f_lin, w_lin, dw_lin);
   GimpShape::weights_1d(3.3, 1e-9, f_g, w_g, dw_g);
   mpm_test::check_below(std::abs(w_g[f_lin - f_g] - w_lin[0]), 1e-8, "GIMP -> linear for lp -> 0");
+
+  // The B-spline in the interior: 3/4 - r^2 at the nearest node, (3/2 - |r|)^2 / 2 at the
+  // others; within half a cell of a face (folded) the linear hats.
+  double w_b[3], dw_b[3];
+  int    f_b;
+  QuadraticBSplineShape::weights_1d(3.3, 0.0, f_b, w_b, dw_b);
+  mpm_test::check(f_b == 2, "B-spline stencil starts one node below the nearest", f_b, 2);
+  mpm_test::check_below(std::abs(w_b[1] - (0.75 - 0.09)) + std::abs(w_b[0] - 0.5 * 0.2 * 0.2) +
+                          std::abs(w_b[2] - 0.5 * 0.8 * 0.8),
+                        1e-15, "B-spline weights at s = 3.3");
+  stencil_weights_1d<QuadraticBSplineShape>(0.2, 0.0, 5, f_b, w_b, dw_b);
+  mpm_test::check_below(std::abs(w_b[0]) + std::abs(w_b[1] - 0.8) + std::abs(w_b[2] - 0.2) +
+                          std::abs(dw_b[1] + 1) + std::abs(dw_b[2] - 1),
+                        1e-15, "B-spline folded at the lower face: the linear hats");
+  stencil_weights_1d<QuadraticBSplineShape>(4.9, 0.0, 5, f_b, w_b, dw_b);
+  mpm_test::check_below(std::abs(w_b[2]) + std::abs(w_b[1] - 0.9) + std::abs(w_b[0] - 0.1), 1e-15,
+                        "B-spline folded at the upper face: the linear hats");
   return mpm_test::finish("test_shape_functions");
 }

@@ -123,6 +123,23 @@ int main()
         report<2>("V1 column, GPU sorted every 7", compare_points(cpu, gpu, 10.0 / 32), spread, n, true);
       }
       {
+        // The same with the quadratic B-spline (its boundary fold at the base and the sides)
+        const long            n = 1000;
+        HostPoints<2, double> cpu, gpu, initial;
+        ColumnSetup           setup{32, 0.5, DomainUpdate::none};
+        setup.max_steps = 0;
+        elastic_column<QuadraticBSplineShape, CpuTarget>(setup, initial);
+        setup.max_steps = n;
+        elastic_column<QuadraticBSplineShape, CpuTarget>(setup, cpu, &initial);
+        const Difference spread = cpu_reordering_spread(initial, cpu, 10.0 / 32, [&](auto &out, const auto *start) {
+          elastic_column<QuadraticBSplineShape, CpuTarget>(setup, out, start);
+        });
+        elastic_column<QuadraticBSplineShape, CudaTarget>(setup, gpu, &initial);
+        report<2>("V1 column 32 cells (2D B-spline)", compare_points(cpu, gpu, 10.0 / 32), spread, n, true);
+        elastic_column<QuadraticBSplineShape, CudaSortedTarget>(setup, gpu, &initial);
+        report<2>("V1 column B-spline, GPU sorted every 7", compare_points(cpu, gpu, 10.0 / 32), spread, n, true);
+      }
+      {
         // V3 geometry, elastic, the equilibration's steps (points held, the grid keeping its
         // velocities, damping 0.8) from zero stress. The damped path follows round-off (the
         // damping's sign of a nodal velocity near zero: after 600 steps the CPU with its points

@@ -10,6 +10,7 @@ int main()
   try
     {
       mpm_test::check_column_convergence<mpm_test::CudaTarget>({16, 32, 64}, true);
+      mpm_test::check_bspline_column<mpm_test::CudaTarget>({16, 32, 64}, true);
     }
   catch (const std::exception &e)
     {

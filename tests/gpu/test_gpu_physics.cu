@@ -217,6 +217,8 @@ int main()
       shape_functions<3, LinearShape>("linear", rng);
       shape_functions<2, GimpShape>("GIMP", rng);
       shape_functions<3, GimpShape>("GIMP", rng);
+      shape_functions<2, QuadraticBSplineShape>("quadratic B-spline", rng);
+      shape_functions<3, QuadraticBSplineShape>("quadratic B-spline", rng);
       jaumann_rotation();
     }
   catch (const std::exception &e)

@@ -15,6 +15,7 @@
 // it slower (doc/performance.md), so it is not the default.
 #pragma once
 
+#include <mpm/core/shape_functions.h>
 #include <mpm/core/views.h>
 
 #include <cmath>
@@ -102,7 +103,8 @@ namespace mpm
       : inv_h(Real(1) / grid.h)
     {
       for (int d = 0; d < dim; ++d)
-        Shape::weights_1d((x[d] - grid.origin[d]) * inv_h, half_length[d] * inv_h, first[d], w[d], dw[d]);
+        stencil_weights_1d<Shape>((x[d] - grid.origin[d]) * inv_h, half_length[d] * inv_h, grid.n_cells[d], first[d], w[d],
+                                 dw[d]);
     }
 
     template <typename Visitor>
@@ -159,7 +161,8 @@ namespace mpm
     Real          w[dim][n], dw[dim][n];
     const Real    inv_h = Real(1) / grid.h;
     for (int d = 0; d < dim; ++d)
-      Shape::weights_1d((x[d] - grid.origin[d]) * inv_h, half_length[d] * inv_h, first[d], w[d], dw[d]);
+      stencil_weights_1d<Shape>((x[d] - grid.origin[d]) * inv_h, half_length[d] * inv_h, grid.n_cells[d], first[d], w[d],
+                                 dw[d]);
 
 #  if !defined(MPM_UNROLL_STENCIL)
     constexpr int n_stencil = dim == 2 ? n * n : n * n * n;

@@ -16,8 +16,9 @@ namespace mpm
   // nodes around them (the vertices of the home cell's neighbours).
   inline double safe_distance_outside_home_cell(const ShapeFunction shape)
   {
-    // GIMP: stencil first node floor(s + 1/2) - 1, three nodes; linear: floor(s), two.
-    return shape == ShapeFunction::gimp ? 0.5 : 1.0;
+    // GIMP and the B-spline: stencil first node floor(s + 1/2) - 1, three nodes; linear:
+    // floor(s), two.
+    return shape == ShapeFunction::linear ? 1.0 : 0.5;
   }
 
   // Distance of point i outside its home cell (0 inside), in cell units, max-norm.

@@ -15,13 +15,15 @@ namespace mpm
   enum class ShapeFunction : int
   {
     linear = 0, // standard MPM: hat functions on the cell containing the point
-    gimp   = 1  // generalised interpolation MP, particle domain of half-length lp
+    gimp   = 1, // generalised interpolation MP, particle domain of half-length lp
+    bspline2 = 2  // quadratic B-spline, its ghost node at a lattice face folded into the face's nodes
   };
 
   // Standard MPM: the two nodes of the cell containing s.
   struct LinearShape
   {
-    static constexpr int n_per_direction = 2;
+    static constexpr int  n_per_direction = 2;
+    static constexpr bool folds_boundary  = false;
 
     template <typename Real>
     MPM_HOST_DEVICE static void
@@ -71,7 +73,8 @@ namespace mpm
   // GIMP: the nearest node and its two neighbours cover the support h + lp <= 3h/2.
   struct GimpShape
   {
-    static constexpr int n_per_direction = 3;
+    static constexpr int  n_per_direction = 3;
+    static constexpr bool folds_boundary  = false; // weights beyond the lattice are zero for points inside
 
     template <typename Real>
     MPM_HOST_DEVICE static void
@@ -82,4 +85,87 @@ namespace mpm
         gimp_node_weight(s - Real(first + k), lp, w[k], dw[k]);
     }
   };
+
+  // Quadratic B-spline (C1, support 3h) centred on each node: the nearest node and its two
+  // neighbours. Within half a cell of a lattice face the stencil reaches a node outside the
+  // lattice; fold_boundary (below) removes it.
+  struct QuadraticBSplineShape
+  {
+    static constexpr int  n_per_direction = 3;
+    static constexpr bool folds_boundary  = true;
+
+    template <typename Real>
+    MPM_HOST_DEVICE static void
+    weights_1d(const Real s, const Real /*lp*/, int &first, Real w[3], Real dw[3])
+    {
+      first = static_cast<int>(std::floor(s + Real(0.5))) - 1;
+      for (int k = 0; k < 3; ++k)
+        {
+          const Real r    = s - Real(first + k); // point minus node: d/dx_point = d/dr
+          const Real a    = r < Real(0) ? -r : r;
+          const Real sign = r < Real(0) ? Real(-1) : Real(1);
+          if (a < Real(0.5))
+            {
+              w[k]  = Real(0.75) - r * r;
+              dw[k] = Real(-2) * r;
+            }
+          else if (a < Real(1.5))
+            {
+              const Real b = Real(1.5) - a;
+              w[k]         = Real(0.5) * b * b;
+              dw[k]        = -sign * b;
+            }
+          else
+            {
+              w[k]  = Real(0);
+              dw[k] = Real(0);
+            }
+        }
+    }
+  };
+
+  // Boundary treatment of the B-spline: the value at the ghost node one cell outside a face
+  // is the linear extrapolation of the face node and its inner neighbour, u_ghost = 2 u_face
+  // - u_inner, so the ghost's weight moves to them (x2 and x-1). Partition of unity and the
+  // reproduction of linear fields hold up to the face, all weights stay >= 0 (within half a
+  // cell of the face they become the linear hats 1 - r and r, meeting the B-splines C1 at
+  // r = 1/2), and no node outside the lattice is used. n_cells: the lattice's cells along the
+  // direction; first, w, dw from Shape::weights_1d.
+  template <typename Shape, typename Real>
+  MPM_HOST_DEVICE inline void fold_boundary(const int n_cells, const int first, Real w[], Real dw[])
+  {
+    if constexpr (Shape::folds_boundary)
+      {
+        static_assert(Shape::n_per_direction == 3, "the fold is written for three nodes per direction");
+        if (first == -1) // node -1 is the ghost below face 0
+          {
+            w[1] += Real(2) * w[0];
+            w[2] -= w[0];
+            dw[1] += Real(2) * dw[0];
+            dw[2] -= dw[0];
+            w[0] = dw[0] = Real(0);
+          }
+        if (first + 2 == n_cells + 1) // node n_cells + 1 is the ghost above face n_cells
+          {
+            w[1] += Real(2) * w[2];
+            w[0] -= w[2];
+            dw[1] += Real(2) * dw[2];
+            dw[0] -= dw[2];
+            w[2] = dw[2] = Real(0);
+          }
+      }
+    else
+      {
+        (void)n_cells, (void)first, (void)w, (void)dw;
+      }
+  }
+
+  // The weights of a point's stencil along one direction, boundary treatment included.
+  template <typename Shape, typename Real>
+  MPM_HOST_DEVICE inline void stencil_weights_1d(const Real s, const Real lp, const int n_cells, int &first, Real w[],
+                                                 Real dw[])
+  {
+    Shape::weights_1d(s, lp, first, w, dw);
+    fold_boundary<Shape>(n_cells, first, w, dw);
+  }
 } // namespace mpm

@@ -913,6 +913,8 @@ namespace mpm
   {
     if (shape == ShapeFunction::gimp)
       return explicit_step<dim, GimpShape>(backend, g, p, materials, s, dt, exchange, averaging_pending);
+    if (shape == ShapeFunction::bspline2)
+      return explicit_step<dim, QuadraticBSplineShape>(backend, g, p, materials, s, dt, exchange, averaging_pending);
     return explicit_step<dim, LinearShape>(backend, g, p, materials, s, dt, exchange, averaging_pending);
   }
 } // namespace mpm

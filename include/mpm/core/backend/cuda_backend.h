@@ -298,7 +298,7 @@ namespace mpm
       int        first[dim];
       Real       w[dim][n], dw[dim][n];
       for (int d = 0; d < dim; ++d)
-        Shape::weights_1d((x[d] - g.origin[d]) * inv_h, lp[d] * inv_h, first[d], w[d], dw[d]);
+        stencil_weights_1d<Shape>((x[d] - g.origin[d]) * inv_h, lp[d] * inv_h, g.n_cells[d], first[d], w[d], dw[d]);
       long       lattice_stride[dim], base;
       const bool inside = stencil_base<dim, n>(g, first, lattice_stride, base);
 
