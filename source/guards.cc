@@ -390,8 +390,20 @@ namespace mpm
       {
         const double dt    = p.adaptive_time_step ? p.cfl * p.cell_size / (c_el + v0) : p.fixed_time_step;
         double       steps = p.end_time / dt;
+        // An output interval below the step cuts every step to land on an output time (at
+        // least 1e-12 End time, source/simulator.cc): the outputs then set the steps.
+        const bool landing = p.output_interval > 0 && p.output_interval < dt;
+        if (landing)
+          steps = p.end_time / std::max(p.output_interval, 1e-12 * p.end_time);
         if (p.max_steps > 0)
           steps = std::min(steps, double(p.max_steps));
+        if (landing && !(steps <= p.max_predicted_steps))
+          refuse("Output/Output interval",
+                 number(p.output_interval) + " s is below the first time step " + number(dt) +
+                   " s, and every step is cut to land on an output time: about " + number(steps) +
+                   " steps to Solver/End time = " + number(p.end_time) + " s, more than Solver/Maximum "
+                   "predicted steps = " + number(p.max_predicted_steps) + ": the run would not end. Is the "
+                   "interval mistyped? 0 writes only the initial and final states.");
         if (!(steps <= p.max_predicted_steps))
           refuse("Solver/Maximum predicted steps",
                  "the first time step " +
