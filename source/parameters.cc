@@ -139,10 +139,13 @@ namespace mpm
                       "Grid shape functions: linear (standard MPM), GIMP (generalised interpolation) or "
                       "quadratic B-spline (C1, three nodes per direction; within half a cell of the grid's "
                       "faces it becomes linear, doc/theory.md).");
-    prm.declare_entry("GIMP domain update", "none", Patterns::Selection("none|det F|F_ii"),
+    prm.declare_entry("GIMP domain update", "none", Patterns::Selection("none|det F|F_ii|U"),
                       "How GIMP particle domains follow the deformation: none (uGIMP), det F (cpGIMP, "
-                      "half-lengths scaled by det(F)^(1/dim)) or F_ii (cpGIMP, half-length i scaled by F_ii; exact "
-                      "for stretch along the axes, wrong under rotation). Only with Shape function = GIMP.");
+                      "half-lengths scaled by det(F)^(1/dim)), F_ii (cpGIMP, half-length i scaled by F_ii; exact "
+                      "for stretch along the axes, the domain vanishes under a rotation by 90 degrees) or U "
+                      "(cpGIMP, half-length i scaled by U_ii, U the stretch tensor of the polar decomposition "
+                      "F = R U: F_ii's accuracy under stretch, unchanged by rotation). Only with Shape function = "
+                      "GIMP.");
     prm.declare_entry("Time step", "adaptive", Patterns::Selection("adaptive|fixed"),
                       "adaptive: dt = CFL number * h / (c_el + max |v_p|); fixed: dt = Fixed time step.");
     prm.declare_entry("CFL number", "0.5", Patterns::Double(0, 1),
@@ -439,7 +442,9 @@ namespace mpm
     shape_function = shape == "GIMP" ? ShapeFunction::gimp :
                      shape == "quadratic B-spline" ? ShapeFunction::bspline2 : ShapeFunction::linear;
     const std::string du = prm.get("GIMP domain update");
-    domain_update = du == "det F" ? DomainUpdate::det_F : (du == "F_ii" ? DomainUpdate::stretch : DomainUpdate::none);
+    domain_update = du == "det F" ? DomainUpdate::det_F :
+                    du == "F_ii"  ? DomainUpdate::stretch :
+                    du == "U"     ? DomainUpdate::U : DomainUpdate::none;
     if (shape_function != ShapeFunction::gimp && domain_update != DomainUpdate::none)
       fail("Solver/GIMP domain update", "'" + du + "' needs Shape function = GIMP; with Shape function = " + shape +
                                         " the only allowed value is none.");

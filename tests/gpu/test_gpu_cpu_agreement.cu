@@ -37,9 +37,11 @@
 // Frictional walls are held like the damped scenes too: the friction acts only where a wall
 // node moves into the wall, and stops the tangential velocity at zero at most, two switches
 // that a node at the switch takes either way.
-// Only GIMP is compared: its weights are C1 in the point position, so a perturbation of a
-// position changes the weights by as much; standard MPM's gradients jump at cell faces.
+// Only GIMP and the quadratic B-spline are compared: their weights are C1 in the point
+// position, so a perturbation of a position changes the weights by as much; standard MPM's
+// gradients jump at cell faces.
 #include "../core/check.h"
+#include "../core/spinning_block.h"
 #include "gpu_scenes.h"
 
 using namespace mpm;
@@ -89,6 +91,47 @@ void report(const char *scene, const Difference &gpu, const Difference &reordere
   check(gpu.removed_mismatch == 0, (std::string(scene) + ": same points removed").c_str());
 }
 
+// The V1 column with the given shape, CPU against the GPU, unsorted and sorted.
+template <typename Shape>
+void column_agreement(const char *shape, const DomainUpdate update)
+{
+  const long            n = 1000;
+  HostPoints<2, double> cpu, gpu, initial;
+  ColumnSetup           setup{32, 0.5, update};
+  setup.max_steps = 0;
+  elastic_column<Shape, CpuTarget>(setup, initial);
+  setup.max_steps = n;
+  elastic_column<Shape, CpuTarget>(setup, cpu, &initial);
+  const Difference spread = cpu_reordering_spread(initial, cpu, 10.0 / 32, [&](auto &out, const auto *start) {
+    elastic_column<Shape, CpuTarget>(setup, out, start);
+  });
+  elastic_column<Shape, CudaTarget>(setup, gpu, &initial);
+  report<2>((std::string("V1 column 32 cells (") + shape + ")").c_str(), compare_points(cpu, gpu, 10.0 / 32), spread,
+            n, true);
+  elastic_column<Shape, CudaSortedTarget>(setup, gpu, &initial);
+  report<2>((std::string("V1 column ") + shape + ", GPU sorted every 7").c_str(), compare_points(cpu, gpu, 10.0 / 32),
+            spread, n, true);
+}
+
+// The spinning block with cpGIMP's U domain update, 300 steps (a third of the quarter turn).
+template <int dim>
+void spin_agreement()
+{
+  const long              n = 300;
+  HostPoints<dim, double> cpu, gpu, initial;
+  spinning_block<dim, GimpShape>(DomainUpdate::U, initial, M_PI / 2, 0);
+  spinning_block<dim, GimpShape>(DomainUpdate::U, cpu, M_PI / 2, n, &initial);
+  const Difference spread = cpu_reordering_spread(initial, cpu, 0.125, [&](auto &out, const auto *start) {
+    spinning_block<dim, GimpShape>(DomainUpdate::U, out, M_PI / 2, n, start);
+  });
+  spinning_block<dim, GimpShape, CudaTarget>(DomainUpdate::U, gpu, M_PI / 2, n, &initial);
+  report<dim>(dim == 2 ? "spinning block, cpGIMP U (2D)" : "spinning block, cpGIMP U (3D)",
+              compare_points(cpu, gpu, 0.125), spread, n, false);
+  spinning_block<dim, GimpShape, CudaSortedTarget>(DomainUpdate::U, gpu, M_PI / 2, n, &initial);
+  report<dim>(dim == 2 ? "spinning block U, GPU sorted every 7 (2D)" : "spinning block U, GPU sorted every 7 (3D)",
+              compare_points(cpu, gpu, 0.125), spread, n, false);
+}
+
 // Fraction of the points with accumulated plastic strain.
 template <int dim>
 double plastic_fraction(const HostPoints<dim, double> &p)
@@ -105,40 +148,15 @@ int main()
     return skip_code;
   try
     {
-      {
-        // V1 column, 32 cells, 1000 steps (the ramp has started, points have moved)
-        const long            n = 1000;
-        HostPoints<2, double> cpu, gpu, initial;
-        ColumnSetup           setup{32};
-        setup.max_steps = 0;
-        elastic_column<GimpShape, CpuTarget>(setup, initial);
-        setup.max_steps = n;
-        elastic_column<GimpShape, CpuTarget>(setup, cpu, &initial);
-        const Difference spread = cpu_reordering_spread(initial, cpu, 10.0 / 32, [&](auto &out, const auto *start) {
-          elastic_column<GimpShape, CpuTarget>(setup, out, start);
-        });
-        elastic_column<GimpShape, CudaTarget>(setup, gpu, &initial);
-        report<2>("V1 column 32 cells (2D GIMP)", compare_points(cpu, gpu, 10.0 / 32), spread, n, true);
-        elastic_column<GimpShape, CudaSortedTarget>(setup, gpu, &initial);
-        report<2>("V1 column, GPU sorted every 7", compare_points(cpu, gpu, 10.0 / 32), spread, n, true);
-      }
-      {
-        // The same with the quadratic B-spline (its boundary fold at the base and the sides)
-        const long            n = 1000;
-        HostPoints<2, double> cpu, gpu, initial;
-        ColumnSetup           setup{32, 0.5, DomainUpdate::none};
-        setup.max_steps = 0;
-        elastic_column<QuadraticBSplineShape, CpuTarget>(setup, initial);
-        setup.max_steps = n;
-        elastic_column<QuadraticBSplineShape, CpuTarget>(setup, cpu, &initial);
-        const Difference spread = cpu_reordering_spread(initial, cpu, 10.0 / 32, [&](auto &out, const auto *start) {
-          elastic_column<QuadraticBSplineShape, CpuTarget>(setup, out, start);
-        });
-        elastic_column<QuadraticBSplineShape, CudaTarget>(setup, gpu, &initial);
-        report<2>("V1 column 32 cells (2D B-spline)", compare_points(cpu, gpu, 10.0 / 32), spread, n, true);
-        elastic_column<QuadraticBSplineShape, CudaSortedTarget>(setup, gpu, &initial);
-        report<2>("V1 column B-spline, GPU sorted every 7", compare_points(cpu, gpu, 10.0 / 32), spread, n, true);
-      }
+      // V1 column, 32 cells, 1000 steps (the ramp has started, points have moved): GIMP
+      // (cpGIMP, F_ii domains) and the quadratic B-spline (its boundary fold at the base and
+      // the sides)
+      column_agreement<GimpShape>("2D GIMP", DomainUpdate::stretch);
+      column_agreement<QuadraticBSplineShape>("2D B-spline", DomainUpdate::none);
+      // A block spun by a quarter turn, cpGIMP with the U domain update (the stretch of the
+      // polar decomposition: closed form in 2D, eigen-decomposition in 3D), undamped
+      spin_agreement<2>();
+      spin_agreement<3>();
       {
         // V3 geometry, elastic, the equilibration's steps (points held, the grid keeping its
         // velocities, damping 0.8) from zero stress. The damped path follows round-off (the

@@ -8,6 +8,7 @@
 // algorithm (doc/theory.md).
 #pragma once
 
+#include <mpm/core/domain_update.h>
 #include <mpm/core/interpolation.h>
 #include <mpm/core/local_damping.h>
 #include <mpm/core/stencil_contribution.h>
@@ -29,14 +30,6 @@ namespace mpm
     musl = 0, // modified update stress last (default)
     usl  = 1, // update stress last
     usf  = 2  // update stress first
-  };
-
-  // How the GIMP particle domain follows the deformation.
-  enum class DomainUpdate : int
-  {
-    none    = 0, // uGIMP: the domain keeps its initial size
-    det_F   = 1, // cpGIMP: half-lengths scaled by (det F)^(1/dim)
-    stretch = 2  // cpGIMP: half-length i scaled by F_ii (exact for stretch along the axes, not rotation)
   };
 
   template <int dim, typename Real>
@@ -659,15 +652,14 @@ namespace mpm
 
         if (s.domain_update != DomainUpdate::none && move)
           {
-            const Real J     = p.volume[i] / p.initial_volume[i];
-            const Real iso   = dim == 2 ? std::sqrt(J) : std::cbrt(J);
+            Real f[dim * dim], scale[dim];
+            for (int k = 0; k < dim * dim; ++k)
+              f[k] = p.deformation_gradient[k][i];
+            gimp_domain_scale<dim>(s.domain_update, f, p.volume[i] / p.initial_volume[i], scale);
             for (int d = 0; d < dim; ++d)
               {
-                const Real scale = s.domain_update == DomainUpdate::det_F ?
-                                     iso :
-                                     std::fabs(p.deformation_gradient[d * dim + d][i]);
                 // GIMP weights are valid up to half a cell.
-                const Real l = p.initial_domain_half_length[d][i] * scale;
+                const Real l = p.initial_domain_half_length[d][i] * scale[d];
                 p.domain_half_length[d][i] = l < Real(0.5) * g.h ? l : Real(0.5) * g.h;
               }
           }
