@@ -52,6 +52,7 @@ namespace
     bool             drucker_prager = true;
     int              sort_every     = 20;
     ShapeFunction    shape          = ShapeFunction::gimp;
+    DomainUpdate     domain         = DomainUpdate::det_F; // GIMP's; P1's own is det F
   };
 
   // Reorder every point array by perm (new point i is old point perm[i]).
@@ -211,6 +212,7 @@ namespace
         }
     };
     StepSettings<3, Real> s = mpm_bench::p1_settings<Real>();
+    s.domain_update         = opt.shape == ShapeFunction::gimp ? opt.domain : DomainUpdate::none;
     const double          c = mpm_bench::p1_wave_speed();
 
     // Warm-up (module load, first launches), then back to the initial state.
@@ -282,6 +284,9 @@ namespace
       label += ", block " + std::to_string(opt.block);
     label += opt.drucker_prager ? ", DP" : ", elastic";
     label += opt.shape == ShapeFunction::linear ? ", linear" : opt.shape == ShapeFunction::bspline2 ? ", B-spline" : "";
+    if (opt.shape == ShapeFunction::gimp)
+      label += opt.domain == DomainUpdate::U ? ", U domains" : opt.domain == DomainUpdate::stretch ? ", F_ii domains" :
+               opt.domain == DomainUpdate::none ? ", uGIMP" : ", det F domains";
     label += opt.sort_every > 0 ? ", sorted every " + std::to_string(opt.sort_every) : ", unsorted";
     const double updates  = double(n_points) * steps / wall;
     const double bytes    = minimal_bytes_per_step<Real>(n_points, n_nodes);
@@ -375,6 +380,17 @@ int main(int argc, char **argv)
             }
           opt.shape = m == "gimp" ? ShapeFunction::gimp : m == "linear" ? ShapeFunction::linear : ShapeFunction::bspline2;
         }
+      else if (a == "--domain" && i + 1 < argc)
+        {
+          const std::string m = argv[++i];
+          if (m != "detF" && m != "Fii" && m != "U" && m != "none")
+            {
+              std::printf("--domain: expected detF, Fii, U or none, got %s\n", m.c_str());
+              return 2;
+            }
+          opt.domain = m == "detF" ? DomainUpdate::det_F : m == "Fii" ? DomainUpdate::stretch :
+                       m == "U"    ? DomainUpdate::U : DomainUpdate::none;
+        }
       else if (a == "--block" && i + 1 < argc)
         opt.block = std::atoi(argv[++i]);
       else if (a == "--table" && i + 1 < argc)
@@ -395,7 +411,7 @@ int main(int argc, char **argv)
         {
           std::printf("usage: %s [--fp32] [--sizes 20,160,640,2560] [--steps N] [--profile] [--table FILE]\n"
                       "          [--order generated|cell|random] [--block N] [--material dp|elastic] [--sort-every N]\n"
-                      "          [--shape gimp|linear|bspline2]\n",
+                      "          [--shape gimp|linear|bspline2] [--domain detF|Fii|U|none]\n",
                       argv[0]);
           return 2;
         }
