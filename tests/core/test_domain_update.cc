@@ -104,6 +104,12 @@ namespace
         for (int i = 0; i < 3; ++i)
           worst_polar = std::max(worst_polar, std::abs(d3[i] - ref[i]));
       }
+    // a point crushed to F = 0: U = 0, not 0/0 (2D closed form; 3D clamps the eigenvalues)
+    const double zero2[4] = {}, zero3[9] = {};
+    double       z2[2], z3[3];
+    right_stretch_diagonal<2>(zero2, z2);
+    right_stretch_diagonal<3>(zero3, z3);
+    check(z2[0] == 0 && z2[1] == 0 && z3[0] == 0 && z3[1] == 0 && z3[2] == 0, "U = 0 for F = 0 (no NaN)");
     std::printf("U_ii: rotation %.1e, rotated stretch %.1e, 2D vs 3D path %.1e, vs polar iteration %.1e\n",
                 worst_rotation, worst_stretch, worst_2d_3d, worst_polar);
     check_below(worst_rotation, 1e-14, "U_ii = 1 for a rotation");

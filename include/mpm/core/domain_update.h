@@ -37,8 +37,9 @@ namespace mpm
         const Real c11 = f[1] * f[1] + f[3] * f[3];
         const Real s   = std::fabs(f[0] * f[3] - f[1] * f[2]); // sqrt(det C) = |det F|
         const Real n   = std::sqrt(c00 + c11 + Real(2) * s);
-        u[0]           = (c00 + s) / n;
-        u[1]           = (c11 + s) / n;
+        // F = 0 (a point crushed to nothing, which the step's checks report): U = 0, not 0/0
+        u[0] = n > Real(0) ? (c00 + s) / n : Real(0);
+        u[1] = n > Real(0) ? (c11 + s) / n : Real(0);
       }
     else
       {
