@@ -24,8 +24,8 @@ open(sys.argv[3], "w").write(text)
 PY
 }
 
-# P2 end to end, shell clock, 1 and 2 ranks
-for np in 1 2; do
+# P2 end to end, shell clock, 1 and 2 ranks (SKIP_P2=1: not)
+for np in $([ "${SKIP_P2:-0}" = 1 ] || echo 1 2); do
   d=$out/p2_np$np
   mkdir -p "$d"
   { cat "$here/../prm/granular_collapse_3d.prm"
@@ -37,7 +37,7 @@ for np in 1 2; do
   rc=$?
   t1=$(date +%s.%N)
   echo "P2 np $np: rc $rc, $(awk "BEGIN{print $t1 - $t0}") s wall (shell clock) | $(grep -E 'done, t =' "$d.log")"
-  grep -E "CUDA device of rank|ghost-node exchange|re-sorts|repartition|set-up" "$d.log" | head -8
+  grep -E "CUDA device of rank|ghost-node exchange|GPU ghost exchange|re-sorts|repartition|set-up" "$d.log" | head -9
   grep -A16 "Total wallclock" "$d.log" | grep -E "MPM step|migrate|repartition|output|history|setup|Total" | head -12
 done
 

@@ -2,7 +2,8 @@
 """Strong-scaling benchmark of dealii-mpm over MPI ranks: the same scene, a fixed number
 of steps, no field output, on each rank count; prints a table (wall time of the steps
 after the set-up, steps/s, point-updates/s, speed-up, efficiency, re-sorts, repartitions and the
-ghost-exchange volume per step the program reports).
+ghost-exchange volume per step the program reports; with Backend = cuda on several ranks
+the exchange's device time per step and the time of the re-sorts).
   mpi_scaling.py EXE [--prm SCENE] [--np 1,2] [--steps 400] [--repeat 3] [--mpirun-args ...]
 Takes the best of --repeat runs (other load on the machine only slows a run down).
 On a cluster pass e.g. --np 1,2,4,8,16,32 --mpirun-args "--map-by core --bind-to core"."""
@@ -60,7 +61,11 @@ with tempfile.TemporaryDirectory() as work:
             n_points = int(re.search(r"(\d+) material points", text).group(1))
             mpi = re.search(r"MPI: (\d+) re-sorts.*?(\d+) points migrated, (\d+) repartitions", text)
             ghosts = re.search(r"ghost nodes (\d+) in all, (\d+) at most on one rank; exchange ([\d.e+-]+) bytes per step", text)
+            exchange = re.search(r"GPU ghost exchange: ([\d.e+-]+) s", text)
+            migrate = re.search(r"\| migrate points\s+\|\s+\d+\s+\|\s+([\d.e+-]+)s", text)
             run = dict(np=np_, step=step, wall=loop, points=n_points,
+                       exchange=float(exchange.group(1)) if exchange else 0.0,
+                       migrate=float(migrate.group(1)) if migrate else 0.0,
                        resorts=int(mpi.group(1)) if mpi else 0, repartitions=int(mpi.group(3)) if mpi else 0,
                        ghosts=int(ghosts.group(1)) if ghosts else 0,
                        bytes=float(ghosts.group(3)) if ghosts else 0.0)
@@ -73,9 +78,10 @@ load = open("/proc/loadavg").read().split()[:3] if os.path.exists("/proc/loadavg
 print(f"scene {os.path.basename(args.prm)}{', backend ' + args.backend if args.backend else ''}, {rows[0]['points']} points, {args.steps} steps, best of {args.repeat}, "
       f"threads per rank {args.threads or 'default'}, {os.cpu_count()} cores, load average {' '.join(load)}")
 print(f"{'ranks':>5} {'wall s':>8} {'step s':>8} {'steps/s':>8} {'pt-upd/s':>10} {'speed-up':>8} {'effic.':>7} "
-      f"{'re-sorts':>8} {'repart.':>7} {'ghosts':>7} {'kB/step':>8}")
+      f"{'re-sorts':>8} {'repart.':>7} {'ghosts':>7} {'kB/step':>8} {'exch ms/st':>10} {'migr. s':>7}")
 for r in rows:
     speedup = base / r["wall"]
     print(f"{r['np']:>5} {r['wall']:>8.3f} {r['step']:>8.3f} {args.steps / r['wall']:>8.1f} "
           f"{r['points'] * args.steps / r['wall']:>10.3e} {speedup:>8.2f} {speedup / r['np']:>7.2f} "
-          f"{r['resorts']:>8} {r['repartitions']:>7} {r['ghosts']:>7} {r['bytes'] / 1e3:>8.1f}")
+          f"{r['resorts']:>8} {r['repartitions']:>7} {r['ghosts']:>7} {r['bytes'] / 1e3:>8.1f} "
+          f"{1e3 * r['exchange'] / args.steps:>10.3f} {r['migrate']:>7.3f}")

@@ -217,14 +217,7 @@ namespace mpm
   template <int dim>
   long BackgroundGrid<dim>::lattice_cell_of(const double *x) const
   {
-    long index = 0;
-    for (int d = dim - 1; d >= 0; --d)
-      {
-        long i = static_cast<long>(std::floor((x[d] - origin[d]) / h));
-        i      = std::min<long>(std::max<long>(i, 0), n_cells[d] - 1);
-        index  = index * n_cells[d] + i;
-      }
-    return index;
+    return mpm::lattice_cell_containing<dim>(origin, h, n_cells, x);
   }
 
   template <int dim>

@@ -474,6 +474,11 @@ namespace mpm
         s.pcout << "  MPI: ghost nodes " << static_cast<long>(sum(ghosts, s.communicator)) << " in all, "
                 << static_cast<long>(max(ghosts, s.communicator)) << " at most on one rank; exchange " << bytes
                 << " bytes per step (" << arrays << " nodal arrays, each ghost value sent to its owner and back)\n";
+        const double exchange = max(s.engine->exchange_seconds(), s.communicator);
+        if (exchange >= 0 && steps > 0)
+          s.pcout << "  GPU ghost exchange: " << exchange << " s on the slowest rank, " << 1e3 * exchange / steps
+                  << " ms per step (device time from the end of each P2G to the sums in place: the copies, the "
+                     "host's part and MPI)\n";
       }
     s.pcout << "  output: " << s.output->n_outputs() << " outputs, " << s.output->task_seconds()
             << " s building and writing files on rank 0";

@@ -7,9 +7,12 @@
 #include <mpm/core/migration.h>
 #include <mpm/cuda/device_engine.h>
 
+#include <cub/device/device_select.cuh>
+
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <stdexcept>
 #include <type_traits>
 #include <utility>
@@ -99,9 +102,46 @@ namespace mpm
         double             *host   = nullptr;
         std::size_t         host_n = 0;
 
+        // The device's time of each exchange, from the end of the work before it to the sums
+        // unpacked (host round trip and MPI included): two pairs of events, used in turn, so
+        // that the last exchange's pair is read at this one's wait, when it has surely passed.
+        cudaEvent_t begin[2] = {}, end[2] = {};
+        bool        pending[2] = {false, false};
+        int         current    = 0;
+        double      seconds    = 0;
+
         Staging()                = default;
         Staging(const Staging &) = delete;
-        ~Staging() { cudaFreeHost(host); }
+        ~Staging()
+        {
+          cudaFreeHost(host);
+          for (int k = 0; k < 2; ++k)
+            if (begin[k] != nullptr)
+              {
+                cudaEventDestroy(begin[k]);
+                cudaEventDestroy(end[k]);
+              }
+        }
+
+        // The exchanges' device time so far (waits for the last one).
+        double exchange_seconds()
+        {
+          for (int k = 0; k < 2; ++k)
+            if (pending[k])
+              {
+                MPM_CUDA_CHECK(cudaEventSynchronize(end[k]));
+                add(k);
+              }
+          return seconds;
+        }
+
+        void add(const int k)
+        {
+          float ms = 0;
+          MPM_CUDA_CHECK(cudaEventElapsedTime(&ms, begin[k], end[k]));
+          seconds += 1e-3 * ms;
+          pending[k] = false;
+        }
 
         void set_index(const std::vector<Index> &i) { index.upload(i); }
 
@@ -129,6 +169,13 @@ namespace mpm
           const cudaStream_t stream  = backend.get_stream();
           const int          threads = 256;
           const long         blocks  = (total + threads - 1) / threads;
+          if (begin[0] == nullptr)
+            for (int k = 0; k < 2; ++k)
+              {
+                MPM_CUDA_CHECK(cudaEventCreate(&begin[k]));
+                MPM_CUDA_CHECK(cudaEventCreate(&end[k]));
+              }
+          MPM_CUDA_CHECK(cudaEventRecord(begin[current], stream));
           if (total > 0)
             {
               pack_kernel<Index><<<blocks, threads, 0, stream>>>(n, count, index.data(), list, packed.data());
@@ -137,6 +184,8 @@ namespace mpm
                 cudaMemcpyAsync(host, packed.data(), total * sizeof(double), cudaMemcpyDeviceToHost, stream));
             }
           MPM_CUDA_CHECK(cudaStreamSynchronize(stream));
+          if (pending[1 - current]) // the last exchange's pair: before this wait in the stream
+            add(1 - current);
           sum(host, count); // collective: every rank calls it, with or without entries
           if (total > 0)
             {
@@ -145,6 +194,9 @@ namespace mpm
               unpack_kernel<Index><<<blocks, threads, 0, stream>>>(n, count, index.data(), packed.data(), list);
               MPM_CUDA_CHECK_LAUNCH();
             }
+          MPM_CUDA_CHECK(cudaEventRecord(end[current], stream));
+          pending[current] = true;
+          current          = 1 - current;
         }
       };
 
@@ -157,41 +209,85 @@ namespace mpm
           to[k] = from[slot[k]];
       }
 
-      // Every point array replaced by (keep) or copied to the host as (take) its entries at
-      // the slots, in the slots' order.
+      // Scratch for the re-sort's gathers, one per element type of the point arrays. Each
+      // gathered array swaps with its type's scratch, which then holds the old array's
+      // memory for the next one: no allocation and no wait once the sizes have settled.
+      struct SlotScratch
+      {
+        DeviceArray<double> reals;
+        DeviceArray<int>    ints;
+        DeviceArray<char>   packed; // take_slots: every array's entries, one download
+        std::vector<char>   host_packed;
+
+        DeviceArray<double> &of(const DeviceArray<double> &) { return reals; }
+        DeviceArray<int>    &of(const DeviceArray<int> &) { return ints; }
+      };
+
+      // The re-sort's split of the points (take_leaving_points).
+      struct ResortScratch
+      {
+        DeviceArray<std::uint8_t> keep_flag, leave_flag;
+        DeviceArray<int>          slot, kept_slots, leaving_slots, index, counts;
+        DeviceArray<char>         temp; // CUB's
+      };
+
+      // Every point array replaced by its entries at the slots, in the slots' order.
       template <int dim>
-      void keep_slots(DevicePoints<dim, double> &points, const DeviceArray<int> &slots, const cudaStream_t stream)
+      void keep_slots(DevicePoints<dim, double> &points, const DeviceArray<int> &slots, SlotScratch &scratch,
+                      const cudaStream_t stream)
       {
         const int m = static_cast<int>(slots.size());
         for_each_point_array<dim>(points, points, [&](auto &array, auto &) {
-          using T = typename std::decay_t<decltype(array)>::value_type;
-          DeviceArray<T> kept(m);
+          using T         = typename std::decay_t<decltype(array)>::value_type;
+          auto &gathered = scratch.of(array);
+          gathered.resize(m);
           if (m > 0)
             {
-              gather_slots_kernel<T><<<(m + 255) / 256, 256, 0, stream>>>(m, slots.data(), array.data(), kept.data());
+              gather_slots_kernel<T>
+                <<<(m + 255) / 256, 256, 0, stream>>>(m, slots.data(), array.data(), gathered.data());
               MPM_CUDA_CHECK_LAUNCH();
             }
-          MPM_CUDA_CHECK(cudaStreamSynchronize(stream)); // before the old array is freed
-          array.swap(kept);
+          array.swap(gathered);
         });
       }
+
+      // The entries at the slots copied to the host, in the slots' order: gathered into one
+      // packed buffer on the device, one download.
       template <int dim>
       void take_slots(const DevicePoints<dim, double> &points, const DeviceArray<int> &slots,
-                      HostPoints<dim, double> &host, const cudaStream_t stream)
+                      HostPoints<dim, double> &host, SlotScratch &scratch, const cudaStream_t stream)
       {
         const int m = static_cast<int>(slots.size());
         host.set_n_state_variables(0); // the device runs the library's models, which have none
         host.resize(m);
-        for_each_point_array<dim>(points, host, [&](const auto &array, auto &to) {
+        size_t bytes = 0;
+        for_each_point_array<dim>(points, host, [&](const auto &array, auto &) {
           using T = typename std::decay_t<decltype(array)>::value_type;
-          DeviceArray<T> taken(m);
+          bytes += (m * sizeof(T) + 7) / 8 * 8;
+        });
+        scratch.packed.resize(bytes);
+        size_t at = 0;
+        for_each_point_array<dim>(points, host, [&](const auto &array, auto &) {
+          using T = typename std::decay_t<decltype(array)>::value_type;
           if (m > 0)
             {
-              gather_slots_kernel<T><<<(m + 255) / 256, 256, 0, stream>>>(m, slots.data(), array.data(), taken.data());
+              gather_slots_kernel<T><<<(m + 255) / 256, 256, 0, stream>>>(
+                m, slots.data(), array.data(), reinterpret_cast<T *>(scratch.packed.data() + at));
               MPM_CUDA_CHECK_LAUNCH();
             }
-          MPM_CUDA_CHECK(cudaStreamSynchronize(stream));
-          taken.download(to);
+          at += (m * sizeof(T) + 7) / 8 * 8;
+        });
+        scratch.host_packed.resize(bytes);
+        if (bytes > 0)
+          MPM_CUDA_CHECK(cudaMemcpyAsync(scratch.host_packed.data(), scratch.packed.data(), bytes,
+                                         cudaMemcpyDeviceToHost, stream));
+        MPM_CUDA_CHECK(cudaStreamSynchronize(stream));
+        at = 0;
+        for_each_point_array<dim>(points, host, [&](const auto &array, auto &to) {
+          using T = typename std::decay_t<decltype(array)>::value_type;
+          if (m > 0)
+            std::memcpy(to.data(), scratch.host_packed.data() + at, m * sizeof(T));
+          at += (m * sizeof(T) + 7) / 8 * 8;
         });
       }
 
@@ -261,6 +357,10 @@ namespace mpm
       ExchangeAdapter              exchange;
       DeviceArray<long>            home_cells; // several ranks: in upload order
       DeviceArray<std::uint8_t>    owned_cells; // several ranks: 1 for each lattice cell this rank owns
+      // The re-sort's (take_leaving_points) flags, slot lists and gathers' scratch: kept
+      // between re-sorts.
+      ResortScratch                resort;
+      SlotScratch                  slot_scratch;
       // The device numbers its nodes in lattice order (one rank, the host's nodes being the
       // whole lattice); otherwise as the host does.
       bool                         lattice_order = false;
@@ -527,56 +627,71 @@ namespace mpm
           impl->averaging_pending = false;
         }
       const int n = impl->points.size();
-      // Per slot: 0 stays, 1 leaves for another rank, 2 left the grid.
-      DeviceArray<std::uint8_t>     status(n);
+      // Per slot: stays, leaves for another rank, or left the grid. The slots of the first
+      // two kinds are listed on the device (CUB's flagged select, in slot order); only the
+      // lists' upload-order indices and the leaving points come down.
+      ResortScratch                &r     = impl->resort;
       const PointsView<dim, double> p     = impl->points.view();
       const GridView<dim, double>   g     = impl->grid.view();
       const std::uint8_t           *owned = impl->owned_cells.data();
-      std::uint8_t                 *out   = status.data();
+      r.keep_flag.resize(n);
+      r.leave_flag.resize(n);
+      r.slot.resize(n);
+      std::uint8_t *keep = r.keep_flag.data(), *leave = r.leave_flag.data();
+      int          *slot = r.slot.data();
       impl->backend.for_each_node(n, [=] MPM_HOST_DEVICE(const int i) {
+        slot[i] = i;
         if (p.material[i] < 0)
           {
-            out[i] = 2;
+            keep[i] = leave[i] = 0;
             return;
           }
-        long cell = 0;
-        for (int d = dim - 1; d >= 0; --d)
-          {
-            long c = static_cast<long>(floor((p.position[d][i] - g.origin[d]) / g.h));
-            c      = c < 0 ? 0 : (c >= g.n_cells[d] ? g.n_cells[d] - 1 : c);
-            cell   = cell * g.n_cells[d] + c;
-          }
-        out[i] = owned[cell] ? 0 : 1;
+        double x[dim];
+        for (int d = 0; d < dim; ++d)
+          x[d] = p.position[d][i];
+        const bool mine = owned[lattice_cell_containing<dim>(g.origin, g.h, g.n_cells, x)] != 0;
+        keep[i]         = mine ? 1 : 0;
+        leave[i]        = mine ? 0 : 1;
       });
-      impl->backend.synchronize();
-      std::vector<std::uint8_t> host_status;
-      status.download(host_status);
-      std::vector<int> original(n);
+      const cudaStream_t stream = impl->backend.get_stream();
+      r.kept_slots.resize(n);
+      r.leaving_slots.resize(n);
+      r.counts.resize(2);
+      size_t bytes = 0;
+      MPM_CUDA_CHECK(cub::DeviceSelect::Flagged(nullptr, bytes, r.slot.data(), r.keep_flag.data(),
+                                                r.kept_slots.data(), r.counts.data(), n, stream));
+      r.temp.resize(std::max<size_t>(bytes, 1));
+      MPM_CUDA_CHECK(cub::DeviceSelect::Flagged(r.temp.data(), bytes, r.slot.data(), r.keep_flag.data(),
+                                                r.kept_slots.data(), r.counts.data(), n, stream));
+      MPM_CUDA_CHECK(cub::DeviceSelect::Flagged(r.temp.data(), bytes, r.slot.data(), r.leave_flag.data(),
+                                                r.leaving_slots.data(), r.counts.data() + 1, n, stream));
+      int counts[2] = {0, 0};
       if (n > 0)
-        MPM_CUDA_CHECK(cudaMemcpy(original.data(), impl->order.original_index(), n * sizeof(int),
-                                  cudaMemcpyDeviceToHost));
-      std::vector<int> kept_slots, leaving_slots;
-      kept_index.clear();
-      leaving_index.clear();
-      int n_dropped = 0;
-      for (int i = 0; i < n; ++i)
-        if (host_status[i] == 0)
-          {
-            kept_slots.push_back(i);
-            kept_index.push_back(original[i]);
-          }
-        else if (host_status[i] == 1)
-          {
-            leaving_slots.push_back(i);
-            leaving_index.push_back(original[i]);
-          }
-        else
-          ++n_dropped;
-      DeviceArray<int> slots;
-      slots.upload(leaving_slots);
-      take_slots<dim>(impl->points, slots, leaving, impl->backend.get_stream());
-      slots.upload(kept_slots);
-      keep_slots<dim>(impl->points, slots, impl->backend.get_stream());
+        MPM_CUDA_CHECK(cudaMemcpyAsync(counts, r.counts.data(), sizeof(counts), cudaMemcpyDeviceToHost, stream));
+      MPM_CUDA_CHECK(cudaStreamSynchronize(stream));
+      const int n_kept = counts[0], n_leaving = counts[1];
+      r.kept_slots.resize(n_kept);
+      r.leaving_slots.resize(n_leaving);
+
+      // Their upload-order indices: original[slot].
+      const int *original = impl->order.original_index();
+      auto       download_original = [&](const DeviceArray<int> &slots, std::vector<int> &index) {
+        const int m = static_cast<int>(slots.size());
+        r.index.resize(m);
+        index.resize(m);
+        if (m == 0)
+          return;
+        const int *from = slots.data();
+        int       *to   = r.index.data();
+        impl->backend.for_each_node(m, [=] MPM_HOST_DEVICE(const int k) { to[k] = original[from[k]]; });
+        MPM_CUDA_CHECK(cudaMemcpyAsync(index.data(), to, m * sizeof(int), cudaMemcpyDeviceToHost, stream));
+        MPM_CUDA_CHECK(cudaStreamSynchronize(stream));
+      };
+      download_original(r.kept_slots, kept_index);
+      download_original(r.leaving_slots, leaving_index);
+      const int n_dropped = n - n_kept - n_leaving;
+      take_slots<dim>(impl->points, r.leaving_slots, leaving, impl->slot_scratch, stream);
+      keep_slots<dim>(impl->points, r.kept_slots, impl->slot_scratch, stream);
       impl->home_cells.resize(0); // append_points sets them
       return n_dropped;
     }
@@ -589,17 +704,15 @@ namespace mpm
       const cudaStream_t stream = impl->backend.get_stream();
       if (added.n_state_variables() != 0)
         throw std::invalid_argument("DeviceEngine::append_points: the device holds no state variables");
+      // In place where the memory held allows (it grows by an eighth when it does not).
       for_each_point_array<dim>(impl->points, added, [&](auto &array, const auto &tail) {
         using T = typename std::decay_t<decltype(array)>::value_type;
-        DeviceArray<T> longer(m + r);
-        if (m > 0)
-          MPM_CUDA_CHECK(cudaMemcpyAsync(longer.data(), array.data(), m * sizeof(T), cudaMemcpyDeviceToDevice, stream));
+        array.resize_preserving(m + r, stream);
         if (r > 0)
           MPM_CUDA_CHECK(
-            cudaMemcpyAsync(longer.data() + m, tail.data(), r * sizeof(T), cudaMemcpyHostToDevice, stream));
-        MPM_CUDA_CHECK(cudaStreamSynchronize(stream));
-        array.swap(longer);
+            cudaMemcpyAsync(array.data() + m, tail.data(), r * sizeof(T), cudaMemcpyHostToDevice, stream));
       });
+      MPM_CUDA_CHECK(cudaStreamSynchronize(stream)); // before the caller's host arrays go
       // The new upload order, and every point at home in its current cell.
       const int n = m + r;
       impl->order.reset(impl->backend, n);
@@ -610,15 +723,18 @@ namespace mpm
       const GridView<dim, double>   g    = impl->grid.view();
       long                         *home = impl->home_cells.data();
       impl->backend.for_each_node(n, [=] MPM_HOST_DEVICE(const int i) {
-        long cell = 0;
-        for (int d = dim - 1; d >= 0; --d)
-          {
-            long c = static_cast<long>(floor((p.position[d][i] - g.origin[d]) / g.h));
-            c      = c < 0 ? 0 : (c >= g.n_cells[d] ? g.n_cells[d] - 1 : c);
-            cell   = cell * g.n_cells[d] + c;
-          }
+        double x[dim];
+        for (int d = 0; d < dim; ++d)
+          x[d] = p.position[d][i];
+        const long cell = lattice_cell_containing<dim>(g.origin, g.h, g.n_cells, x);
         home[i] = cell;
       });
+    }
+
+    template <int dim>
+    double DeviceEngine<dim>::exchange_seconds()
+    {
+      return impl->exchanged_nodes.exchange_seconds() + impl->exchanged_cells.exchange_seconds();
     }
 
     template <int dim>

@@ -8,11 +8,13 @@
 # Usage: mpi_collapse_3d.sh EXE SOURCE_DIR OUTDIR [override lines...]
 set -eu
 exe=$1 src=$2 out=$3 here=$(dirname "$0")
+# numpy for compare_np.py: Debian's python3 (CI), else the first on PATH (GPU hosts)
+py=/usr/bin/python3; "$py" -c "import numpy" 2>/dev/null || py=python3
 shift 3
 bash "$here/run_np.sh" "$exe" "$src/prm/granular_collapse_3d.prm" "$out" "1 2 4" \
   "subsection Grid" "  set Cell size = 0.01" "end" \
   "subsection Solver" "  set End time = 0.1" "  set Local damping = 0" "  set Pressure averaging = true" "end" \
   "subsection Output" "  set Output interval = 0.05" "  set Files per rank = 3" "end" \
   "subsection Parallel" "  set Load balance threshold = 1.02" "end" "$@"
-/usr/bin/python3 "$here/compare_np.py" "$out/np1" "$out/np2" "$out/np4" --rtol 1e-10
-/usr/bin/python3 "$here/compare_np.py" "$out/np1" "$out/np4" --rtol 1e-10 --migrated --repartitioned
+"$py" "$here/compare_np.py" "$out/np1" "$out/np2" "$out/np4" --rtol 1e-10
+"$py" "$here/compare_np.py" "$out/np1" "$out/np4" --rtol 1e-10 --migrated --repartitioned

@@ -9,6 +9,8 @@
 # Usage: mpi_cuda.sh EXE SOURCE_DIR OUTDIR
 set -eu
 exe=$1 src=$2 out=$3 here=$(dirname "$0")
+# numpy for compare_np.py: Debian's python3 (CI), else the first on PATH (GPU hosts)
+py=/usr/bin/python3; "$py" -c "import numpy" 2>/dev/null || py=python3
 if ! nvidia-smi -L >/dev/null 2>&1; then
   echo "no CUDA device: skipped"
   exit 77
@@ -25,4 +27,4 @@ bash "$here/run_np.sh" "$exe" "$src/prm/granular_collapse_3d.prm" "$out/collapse
   "subsection Solver" "  set End time = 0.1" "  set Local damping = 0" "  set Pressure averaging = true" "end" \
   "subsection Output" "  set Output interval = 0.05" "  set Files per rank = 3" "end" \
   "subsection Parallel" "  set Load balance threshold = 1.02" "end"
-/usr/bin/python3 "$here/compare_np.py" "$out/collapse-3d-cpu/np2" "$out/collapse-3d/np2" --rtol 1e-10
+"$py" "$here/compare_np.py" "$out/collapse-3d-cpu/np2" "$out/collapse-3d/np2" --rtol 1e-10

@@ -11,6 +11,23 @@
 
 namespace mpm
 {
+  // Lattice cell containing x, clamped to the grid: i + n_x (j + n_y k). The one formula
+  // for the step, the device's migration kernels and the deal.II layer's lookups, so that
+  // a point on a cell face lands in the same cell everywhere.
+  template <int dim, typename Real>
+  MPM_HOST_DEVICE inline long lattice_cell_containing(const Real origin[dim], const Real h, const int n_cells[dim],
+                                                      const Real x[dim])
+  {
+    long cell = 0;
+    for (int d = dim - 1; d >= 0; --d)
+      {
+        long i = static_cast<long>(std::floor((x[d] - origin[d]) / h));
+        i      = i < 0 ? 0 : (i >= n_cells[d] ? n_cells[d] - 1 : i);
+        cell   = cell * n_cells[d] + i;
+      }
+    return cell;
+  }
+
   // Uniform background lattice; nodes are reached through a lookup so that the
   // node numbering can be deal.II's locally relevant DoF space (and later sparse).
   template <int dim, typename Real>
@@ -51,14 +68,7 @@ namespace mpm
     // Lattice cell containing x (clamped to the grid): i + n_x (j + n_y k).
     MPM_HOST_DEVICE int lattice_cell(const Real x[dim]) const
     {
-      int cell = 0;
-      for (int d = dim - 1; d >= 0; --d)
-        {
-          int i = static_cast<int>(std::floor((x[d] - origin[d]) / h));
-          i     = i < 0 ? 0 : (i >= n_cells[d] ? n_cells[d] - 1 : i);
-          cell  = cell * n_cells[d] + i;
-        }
-      return cell;
+      return static_cast<int>(lattice_cell_containing<dim>(origin, h, n_cells, x));
     }
 
     MPM_HOST_DEVICE int n_lattice_nodes(const int d) const { return n_cells[d] + 1; }

@@ -118,6 +118,10 @@ namespace mpm
 
       int n_points() const;
 
+      // Several ranks: the device time of the ghost exchanges so far, from the end of the
+      // work before each to its sums unpacked (the host round trip and MPI included).
+      double exchange_seconds();
+
     private:
       struct Impl;
       std::unique_ptr<Impl> impl;

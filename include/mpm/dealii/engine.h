@@ -57,6 +57,10 @@ namespace mpm
     // load/store, in cell units (max-norm); MPI runs re-sort before it gets unsafe.
     // An engine that does not track it makes MPI runs re-sort after every step.
     virtual double max_distance_outside_home_cells() { return std::numeric_limits<double>::infinity(); }
+    // Seconds of the ghost-node exchanges so far as the device saw them (the GPU engine on
+    // several ranks: from the end of the work before each exchange to its sums in place);
+    // negative where the engine does not measure them.
+    virtual double exchange_seconds() { return -1; }
     // Steps between re-sorts of the points (Backend/Sort interval); engines that do not
     // re-sort ignore it.
     virtual void set_sort_interval(int /*steps*/) {}

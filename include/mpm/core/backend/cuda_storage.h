@@ -19,7 +19,9 @@
 
 namespace mpm
 {
-  // An owning device array of trivially copyable T.
+  // An owning device array of trivially copyable T. Like std::vector it keeps its memory
+  // when it shrinks, so that the arrays of points that change in number (migration between
+  // ranks) are not freed and allocated again: cudaFree waits for the whole device.
   template <typename T>
   class DeviceArray
   {
@@ -37,16 +39,39 @@ namespace mpm
     }
     ~DeviceArray() { cudaFree(ptr); } // no throwing from a destructor
 
+    // New size; the contents are undefined unless it fits the memory held, which then
+    // keeps them.
     void resize(const size_t new_size)
     {
-      if (new_size == n)
-        return;
+      if (new_size <= capacity)
+        {
+          n = new_size;
+          return;
+        }
       if (ptr != nullptr)
         MPM_CUDA_CHECK(cudaFree(ptr));
-      ptr = nullptr;
-      n   = new_size;
+      ptr      = nullptr;
+      n        = new_size;
+      capacity = new_size;
+      MPM_CUDA_CHECK(cudaMalloc(&ptr, n * sizeof(T)));
+    }
+
+    // New size keeping the first min(old, new) entries. Beyond the memory held it takes
+    // an eighth more than asked (points keep arriving by migration) and copies the old
+    // entries over on `stream`.
+    void resize_preserving(const size_t new_size, const cudaStream_t stream)
+    {
+      if (new_size <= capacity)
+        {
+          n = new_size;
+          return;
+        }
+      DeviceArray longer;
+      longer.resize(new_size + new_size / 8);
+      longer.n = new_size;
       if (n > 0)
-        MPM_CUDA_CHECK(cudaMalloc(&ptr, n * sizeof(T)));
+        MPM_CUDA_CHECK(cudaMemcpyAsync(longer.ptr, ptr, n * sizeof(T), cudaMemcpyDeviceToDevice, stream));
+      swap(longer); // the old memory's cudaFree waits for the copy
     }
 
     void upload(const std::vector<T> &host)
@@ -79,11 +104,13 @@ namespace mpm
     {
       std::swap(ptr, other.ptr);
       std::swap(n, other.n);
+      std::swap(capacity, other.capacity);
     }
 
   private:
-    T     *ptr = nullptr;
-    size_t n   = 0;
+    T     *ptr      = nullptr;
+    size_t n        = 0;
+    size_t capacity = 0;
   };
 
   template <int dim, typename Real>
