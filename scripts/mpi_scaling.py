@@ -61,6 +61,11 @@ with tempfile.TemporaryDirectory() as work:
             n_points = int(re.search(r"(\d+) material points", text).group(1))
             mpi = re.search(r"MPI: (\d+) re-sorts.*?(\d+) points migrated, (\d+) repartitions", text)
             ghosts = re.search(r"ghost nodes (\d+) in all, (\d+) at most on one rank; exchange ([\d.e+-]+) bytes per step", text)
+            beside = re.search(r"built on a thread in ([\d.e+-]+) s, .* and the first (\d+) steps", text)
+            if beside and int(beside.group(2)) >= args.steps:
+                print(f"warning: on {np_} rank(s) every step ran beside deal.II's grid build "
+                      f"({beside.group(1)} s): the time is the build's, not the steps'; ask for more steps",
+                      file=sys.stderr)
             exchange = re.search(r"GPU ghost exchange: ([\d.e+-]+) s", text)
             migrate = re.search(r"\| migrate points\s+\|\s+\d+\s+\|\s+([\d.e+-]+)s", text)
             run = dict(np=np_, step=step, wall=loop, points=n_points,

@@ -288,7 +288,7 @@ namespace mpm
   void BackgroundGrid<dim>::sum_local_cells(Real *const *arrays, const int count) const
   {
     if (n_ranks > 1)
-      exchange_add(*cell_partitioner, arrays, count);
+      cell_exchange.sum(cell_partitioner, arrays, count);
   }
 
   namespace
@@ -307,11 +307,10 @@ namespace mpm
     }
   } // namespace
 
-  // The Partitioner's raw-array exchange, as LinearAlgebra::distributed::Vector's
-  // compress(add) + update_ghost_values() do internally, but without the vector's
-  // ghosted/non-ghosted state (writing into ghost entries of a vector in the ghosted
-  // state and then compressing is what deal.II forbids). All arrays of one call are in
-  // flight together, each on its own channel:
+  // The Partitioner's raw-array exchange (InterleavedExchange), as
+  // LinearAlgebra::distributed::Vector's compress(add) + update_ghost_values() do
+  // internally, but without the vector's ghosted/non-ghosted state (writing into ghost
+  // entries of a vector in the ghosted state and then compressing is what deal.II forbids):
   //   import: ghost entries are added into their owners' entries, then zeroed;
   //   export: owners' sums are copied into every rank's ghost entries.
   template <int dim>
@@ -320,7 +319,7 @@ namespace mpm
   {
     if (n_ranks == 1)
       return;
-    exchange_add(*partitioner, arrays, count);
+    node_exchange.sum(partitioner, arrays, count);
   }
 
   // Cells: gather the owned and ghost cells' entries into the partitioner's layout,
@@ -342,40 +341,10 @@ namespace mpm
         for (std::size_t c = 0; c < n_local; ++c)
           local[i][c] = arrays[i][lattice_cell_of_local_cell_index[c]];
       }
-    exchange_add(*cell_partitioner, local.data(), count);
+    cell_exchange.sum(cell_partitioner, local.data(), count);
     for (int i = 0; i < count; ++i)
       for (std::size_t c = 0; c < n_local; ++c)
         arrays[i][lattice_cell_of_local_cell_index[c]] = local[i][c];
-  }
-
-  template <int dim>
-  template <typename Real>
-  void BackgroundGrid<dim>::exchange_add(const dealii::Utilities::MPI::Partitioner &partitioner,
-                                         Real *const *arrays, const int count) const
-  {
-    const unsigned int n_owned  = partitioner.locally_owned_size();
-    const unsigned int n_ghost  = partitioner.n_ghost_indices();
-    const unsigned int n_import = partitioner.n_import_indices();
-    std::vector<Real> &buffer   = buffer_of<Real>(buffer_double, buffer_float);
-    buffer.resize(std::size_t(count) * n_import);
-    requests.resize(std::max<std::size_t>(requests.size(), count));
-
-    using dealii::ArrayView;
-    auto owned = [&](const int i) { return ArrayView<Real>(arrays[i], n_owned); };
-    auto ghost = [&](const int i) { return ArrayView<Real>(arrays[i] + n_owned, n_ghost); };
-    auto temp  = [&](const int i) { return ArrayView<Real>(buffer.data() + std::size_t(i) * n_import, n_import); };
-
-    for (int i = 0; i < count; ++i)
-      partitioner.import_from_ghosted_array_start(dealii::VectorOperation::add, i, ghost(i), temp(i), requests[i]);
-    for (int i = 0; i < count; ++i)
-      partitioner.import_from_ghosted_array_finish(dealii::VectorOperation::add,
-                                                    ArrayView<const Real>(temp(i).data(), n_import), owned(i),
-                                                    ghost(i), requests[i]);
-    for (int i = 0; i < count; ++i)
-      partitioner.export_to_ghosted_array_start(i, ArrayView<const Real>(arrays[i], n_owned), temp(i), ghost(i),
-                                                 requests[i]);
-    for (int i = 0; i < count; ++i)
-      partitioner.export_to_ghosted_array_finish(ghost(i), requests[i]);
   }
 
   template class BackgroundGrid<2>;

@@ -12,6 +12,7 @@
 
 #include <mpm/core/host_storage.h>
 #include <mpm/core/views.h>
+#include <mpm/dealii/interleaved_exchange.h>
 #include <mpm/dealii/parameters.h>
 
 #include <deal.II/base/partitioner.h>
@@ -135,11 +136,6 @@ namespace mpm
     template <typename Real>
     void sum_cells(Real *const *arrays, int count) const;
 
-    // The Partitioner's add-then-copy-back exchange on count arrays laid out as its
-    // local storage (owned entries, then ghosts).
-    template <typename Real>
-    void exchange_add(const dealii::Utilities::MPI::Partitioner &partitioner, Real *const *arrays,
-                      int count) const;
 
     // Lattice cell index of each owned and ghost cell, in the cell partitioner's local order.
     std::vector<long> lattice_cell_of_local_cell_index;
@@ -151,9 +147,10 @@ namespace mpm
     double                    friction_coefficient[6] = {}; // by boundary id
     std::vector<typename dealii::Triangulation<dim>::active_cell_iterator> cell_of_lattice_cell;
 
-    // Scratch of the exchange: import/export buffers and MPI requests per array.
-    mutable std::vector<double>                   buffer_double, cell_buffer_double;
-    mutable std::vector<float>                    buffer_float, cell_buffer_float;
-    mutable std::vector<std::vector<MPI_Request>> requests;
+    // The exchanges over the node and the cell partitioner (all arrays of a call in one
+    // round of messages), and the scratch of sum_cells.
+    mutable InterleavedExchange node_exchange, cell_exchange;
+    mutable std::vector<double> cell_buffer_double;
+    mutable std::vector<float>  cell_buffer_float;
   };
 } // namespace mpm

@@ -1,0 +1,104 @@
+#include <mpm/dealii/interleaved_exchange.h>
+
+#include <deal.II/base/array_view.h>
+#include <deal.II/base/index_set.h>
+#include <deal.II/base/partitioner.templates.h>
+
+#include <limits>
+#include <string>
+
+namespace mpm
+{
+  template <>
+  InterleavedExchange::Buffers<double> &InterleavedExchange::buffers<double>()
+  {
+    return doubles;
+  }
+  template <>
+  InterleavedExchange::Buffers<float> &InterleavedExchange::buffers<float>()
+  {
+    return floats;
+  }
+
+  const dealii::Utilities::MPI::Partitioner &InterleavedExchange::interleaved(const int count)
+  {
+    auto &made = by_count[count];
+    if (made == nullptr)
+      {
+        const auto                            range = base->local_range();
+        const dealii::types::global_dof_index n     = base->size();
+        AssertThrow(n <= std::numeric_limits<dealii::types::global_dof_index>::max() / count,
+                    dealii::ExcMessage("The grid has too many nodes or cells for deal.II's index type to number " +
+                                       std::to_string(count) + " interleaved arrays of them; configure deal.II with "
+                                       "64-bit indices (DEAL_II_WITH_64BIT_INDICES)."));
+        dealii::IndexSet owned(n * count), ghosts(n * count);
+        owned.add_range(range.first * count, range.second * count);
+        std::vector<dealii::types::global_dof_index> ghost_list;
+        ghost_list.reserve(base->n_ghost_indices() * count);
+        for (const auto g : base->ghost_indices())
+          for (int k = 0; k < count; ++k)
+            ghost_list.push_back(g * count + k);
+        ghosts.add_indices(ghost_list.begin(), ghost_list.end());
+        owned.compress();
+        ghosts.compress();
+        made = std::make_unique<dealii::Utilities::MPI::Partitioner>(owned, ghosts, base->get_mpi_communicator());
+      }
+    return *made;
+  }
+
+  template <typename Real>
+  void InterleavedExchange::sum(const std::shared_ptr<const dealii::Utilities::MPI::Partitioner> &grid_partitioner,
+                                Real *const *arrays, const int count)
+  {
+    if (grid_partitioner != base) // a repartition: new numbering, new neighbours
+      {
+        base = grid_partitioner;
+        by_count.clear();
+        import_local.clear();
+        for (const auto &range : base->import_indices())
+          for (unsigned int i = range.first; i < range.second; ++i)
+            import_local.push_back(i);
+      }
+    const dealii::Utilities::MPI::Partitioner &p = interleaved(count);
+    const std::size_t n_owned = base->locally_owned_size(), n_ghost = base->n_ghost_indices();
+    Buffers<Real>    &b       = buffers<Real>();
+    if (b.owned_size < n_owned * count)
+      {
+        b.owned.reset(new Real[n_owned * count]);
+        b.owned_size = n_owned * count;
+      }
+    b.ghost.resize(n_ghost * count);
+    b.temp.resize(p.n_import_indices());
+    requests.clear();
+
+    Real *const owned = b.owned.get();
+    for (std::size_t j = 0; j < n_ghost; ++j)
+      for (int k = 0; k < count; ++k)
+        b.ghost[j * count + k] = arrays[k][n_owned + j];
+    for (const unsigned int i : import_local)
+      for (int k = 0; k < count; ++k)
+        owned[std::size_t(i) * count + k] = arrays[k][i];
+
+    using dealii::ArrayView;
+    const ArrayView<Real> owned_view(owned, n_owned * count), ghost_view(b.ghost.data(), b.ghost.size()),
+      temp_view(b.temp.data(), b.temp.size());
+    p.import_from_ghosted_array_start(dealii::VectorOperation::add, 0, ghost_view, temp_view, requests);
+    p.import_from_ghosted_array_finish(dealii::VectorOperation::add, ArrayView<const Real>(b.temp.data(), b.temp.size()),
+                                       owned_view, ghost_view, requests);
+    p.export_to_ghosted_array_start(0, ArrayView<const Real>(owned, n_owned * count), temp_view, ghost_view,
+                                    requests);
+    p.export_to_ghosted_array_finish(ghost_view, requests);
+
+    for (const unsigned int i : import_local)
+      for (int k = 0; k < count; ++k)
+        arrays[k][i] = owned[std::size_t(i) * count + k];
+    for (std::size_t j = 0; j < n_ghost; ++j)
+      for (int k = 0; k < count; ++k)
+        arrays[k][n_owned + j] = b.ghost[j * count + k];
+  }
+
+  template void InterleavedExchange::sum(const std::shared_ptr<const dealii::Utilities::MPI::Partitioner> &,
+                                         double *const *, int);
+  template void InterleavedExchange::sum(const std::shared_ptr<const dealii::Utilities::MPI::Partitioner> &,
+                                         float *const *, int);
+} // namespace mpm
