@@ -1,13 +1,18 @@
-// InterleavedExchange (include/mpm/dealii/interleaved_exchange.h) against deal.II's own
-// distributed vector: every rank writes a value into each of its owned and ghost nodes (and
-// cells), the exchange sums them, and the result must equal what
-// LinearAlgebra::distributed::Vector's compress(add) + update_ghost_values() give for each
-// array alone. Values are small integers, so every sum is exact whatever its order: the
-// comparison is exact. Counts 1, 3 and 7 (MUSL's first exchange), double and float, a
-// repartitioned grid, in 2D and 3D; meant for 1 to 4 ranks.
+// InterleavedExchange (include/mpm/dealii/interleaved_exchange.h), two ways:
+// - against deal.II's own distributed vector: every rank writes a value into each of its owned
+//   and ghost nodes (and cells), the exchange sums them, and the result must equal what
+//   LinearAlgebra::distributed::Vector's compress(add) + update_ghost_values() give for each
+//   array alone. Values are small integers, so every sum is exact whatever its order: the
+//   comparison is exact;
+// - against the Partitioner's exchange of one array at a time, on random values: equal to the
+//   bit (the sums are added in the same order).
+// Counts 1, 3 and 7 (MUSL's first exchange), double and float, a repartitioned grid, in 2D
+// and 3D; meant for 1 to 4 ranks.
 #include <mpm/dealii/interleaved_exchange.h>
 
+#include <deal.II/base/array_view.h>
 #include <deal.II/base/mpi.h>
+#include <deal.II/base/partitioner.templates.h>
 #include <deal.II/distributed/tria.h>
 #include <deal.II/dofs/dof_handler.h>
 #include <deal.II/dofs/dof_tools.h>
@@ -18,6 +23,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
+#include <random>
 #include <memory>
 #include <string>
 #include <vector>
@@ -72,6 +79,56 @@ namespace
                   count, sizeof(Real) == 8 ? "double" : "float", worst);
   }
 
+  // The Partitioner's exchange of one array (owned entries, then ghosts), as deal.II's vector
+  // does it inside compress(add) + update_ghost_values().
+  template <typename Real>
+  void one_array_exchange(const Utilities::MPI::Partitioner &p, std::vector<Real> &array)
+  {
+    const unsigned int       n_owned = p.locally_owned_size();
+    std::vector<Real>        temp(p.n_import_indices());
+    std::vector<MPI_Request> requests;
+    const ArrayView<Real>    owned(array.data(), n_owned), ghost(array.data() + n_owned, p.n_ghost_indices()),
+      buffer(temp.data(), temp.size());
+    p.import_from_ghosted_array_start(VectorOperation::add, 0, ghost, buffer, requests);
+    p.import_from_ghosted_array_finish(VectorOperation::add, ArrayView<const Real>(temp.data(), temp.size()), owned,
+                                       ghost, requests);
+    p.export_to_ghosted_array_start(0, ArrayView<const Real>(array.data(), n_owned), buffer, ghost, requests);
+    p.export_to_ghosted_array_finish(ghost, requests);
+  }
+
+  template <typename Real>
+  void check_bitwise(const std::shared_ptr<const Utilities::MPI::Partitioner> &partitioner,
+                     mpm::InterleavedExchange &exchange, const int count, const char *what)
+  {
+    const MPI_Comm     comm    = partitioner->get_mpi_communicator();
+    const unsigned int rank    = Utilities::MPI::this_mpi_process(comm);
+    const std::size_t  n_local = partitioner->locally_owned_size() + partitioner->n_ghost_indices();
+    std::mt19937       random(1234 + rank);
+    std::uniform_real_distribution<double> value(-1, 1);
+    std::vector<std::vector<Real>> arrays(count, std::vector<Real>(n_local)), alone;
+    std::vector<Real *>            pointers(count);
+    for (int k = 0; k < count; ++k)
+      {
+        for (Real &v : arrays[k])
+          v = static_cast<Real>(value(random));
+        pointers[k] = arrays[k].data();
+      }
+    alone = arrays;
+    exchange.sum(partitioner, pointers.data(), count);
+    long differing = 0;
+    for (int k = 0; k < count; ++k)
+      {
+        one_array_exchange(*partitioner, alone[k]);
+        for (std::size_t i = 0; i < n_local; ++i)
+          differing += std::memcmp(&alone[k][i], &arrays[k][i], sizeof(Real)) != 0 ? 1 : 0;
+      }
+    differing = Utilities::MPI::sum(differing, comm);
+    failures += differing == 0 ? 0 : 1;
+    if (rank == 0)
+      std::printf("%s %s, %d array(s), %s, random values: %ld entries differ from the one-array exchange\n",
+                  differing == 0 ? "ok  " : "FAIL", what, count, sizeof(Real) == 8 ? "double" : "float", differing);
+  }
+
   template <int dim>
   void run(const MPI_Comm comm)
   {
@@ -97,6 +154,9 @@ namespace
             check<double>(cell_partitioner, cells, count, (grid + ", cells").c_str());
           }
         check<float>(node_partitioner, nodes, 7, (grid + ", nodes").c_str());
+        check_bitwise<double>(node_partitioner, nodes, 7, (grid + ", nodes").c_str());
+        check_bitwise<double>(cell_partitioner, cells, 2, (grid + ", cells").c_str());
+        check_bitwise<float>(node_partitioner, nodes, 3, (grid + ", nodes").c_str());
         // Refine a corner and let p4est repartition: new numbering, new neighbours.
         for (const auto &cell : triangulation.active_cell_iterators())
           if (cell->is_locally_owned() && cell->center()[0] < 0.2)

@@ -136,7 +136,6 @@ namespace mpm
     template <typename Real>
     void sum_cells(Real *const *arrays, int count) const;
 
-
     // Lattice cell index of each owned and ghost cell, in the cell partitioner's local order.
     std::vector<long> lattice_cell_of_local_cell_index;
 
