@@ -16,6 +16,7 @@
 #  endif
 
 #  include <algorithm>
+#  include <chrono>
 #  include <iostream>
 #  include <map>
 #endif
@@ -66,16 +67,22 @@ namespace mpm
       // Bytes one rank moves between device and host per array of one exchange (each way).
       std::size_t staged_bytes_per_array() const { return sizeof(double) * nodes.size(); }
 
+      // The host's part of the exchanges so far: the copies into and out of the
+      // partitioner's layout and the partitioner's MPI.
+      double host_seconds() const { return seconds; }
+
     private:
       const BackgroundGrid<dim>       &grid;
       const std::vector<unsigned int> nodes, cells;
       const std::size_t               n_local_nodes, n_local_cells;
       std::vector<double>             scratch;
+      double                          seconds = 0;
 
       template <typename Exchange>
       void sum(double *values, const int count, const std::vector<unsigned int> &local, const std::size_t n_local,
                Exchange &&exchange)
       {
+        const auto start = std::chrono::steady_clock::now();
         const std::size_t n = local.size();
         // Only grows: the two exchanges of a step carry different numbers of arrays, and a
         // vector growing back zero-fills its new part (8 MB a step on P1's 1.6M-point ranks).
@@ -92,6 +99,7 @@ namespace mpm
         for (int k = 0; k < count; ++k)
           for (std::size_t j = 0; j < n; ++j)
             values[k * n + j] = arrays[k][local[j]];
+        seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       }
     };
 
@@ -135,17 +143,19 @@ namespace mpm
 
       // The re-sort on the device: only the points that now lie in another rank's cell
       // come down, travel (deal.II's some_to_some, to the owner of their ghost cell) and go
-      // up on their new rank; the handler is left behind until sync().
+      // up on their new rank, with their labels; the labels of the points that stay never
+      // leave the device. The handler is left behind until sync().
       unsigned int resort(MaterialPoints<dim> &p) override
       {
         if (shared_grid == nullptr)
           return store(p);
-        HostPoints<dim, double> leaving;
-        std::vector<int>        leaving_index, kept_index;
-        const int               dropped = device->take_leaving_points(leaving, leaving_index, kept_index);
+        HostPoints<dim, double>          leaving;
+        std::vector<std::vector<double>> leaving_labels;
+        const int                        dropped = device->take_leaving_points(leaving, leaving_labels);
 
         const unsigned int this_rank = dealii::Utilities::MPI::this_mpi_process(shared_grid->communicator);
         const int          n_values  = values_per_point(leaving);
+        const int          n_labels  = static_cast<int>(leaving_labels.size());
         std::map<unsigned int, std::vector<double>> outgoing;
         for (int k = 0; k < leaving.size(); ++k)
           {
@@ -160,43 +170,20 @@ namespace mpm
             for_each_point_array<dim>(leaving, leaving, [&](const auto &array, const auto &) {
               to.push_back(static_cast<double>(array[k]));
             });
-            to.push_back(static_cast<double>(labels->id[leaving_index[k]]));
-            for (int d = 0; d < dim; ++d)
-              to.push_back(labels->initial_position[d][leaving_index[k]]);
+            for (int l = 0; l < n_labels; ++l)
+              to.push_back(leaving_labels[l][k]);
           }
         const std::map<unsigned int, std::vector<double>> incoming =
           dealii::Utilities::MPI::some_to_some(shared_grid->communicator, outgoing);
 
-        // The new upload order: the points that stayed, then those received, by rank.
-        auto new_labels                  = std::make_shared<PointLabels<dim>>();
-        new_labels->state_variable_names = labels->state_variable_names;
+        // Appended in the order of the senders' ranks.
         int n_received = 0;
         for (const auto &from : incoming)
-          n_received += static_cast<int>(from.second.size()) / (n_values + 1 + dim);
-        // The kept points' labels, gathered on the host's threads (the single loop was part of
-        // the 130 ms that a re-sort of 6.4M points per rank took on an H200 host).
-        const int n_kept = static_cast<int>(kept_index.size());
-        new_labels->id.resize(n_kept);
-        for (int d = 0; d < dim; ++d)
-          new_labels->initial_position[d].resize(n_kept);
-        dealii::parallel::apply_to_subranges(
-          0, n_kept,
-          [&](const int begin, const int end) {
-            for (int j = begin; j < end; ++j)
-              {
-                const int i          = kept_index[j];
-                new_labels->id[j]    = labels->id[i];
-                for (int d = 0; d < dim; ++d)
-                  new_labels->initial_position[d][j] = labels->initial_position[d][i];
-              }
-          },
-          1 << 14);
-        new_labels->id.reserve(n_kept + n_received);
-        for (int d = 0; d < dim; ++d)
-          new_labels->initial_position[d].reserve(n_kept + n_received);
+          n_received += static_cast<int>(from.second.size()) / (n_values + n_labels);
         HostPoints<dim, double> received;
         received.set_n_state_variables(leaving.n_state_variables());
         received.resize(n_received);
+        std::vector<std::vector<double>> received_labels(n_labels, std::vector<double>(n_received));
         int k = 0;
         for (const auto &from : incoming)
           for (std::size_t at = 0; at < from.second.size(); ++k)
@@ -205,12 +192,11 @@ namespace mpm
                 using T  = typename std::decay_t<decltype(array)>::value_type;
                 array[k] = static_cast<T>(from.second[at++]);
               });
-              new_labels->id.push_back(static_cast<dealii::types::particle_index>(from.second[at++]));
-              for (int d = 0; d < dim; ++d)
-                new_labels->initial_position[d].push_back(from.second[at++]);
+              for (int l = 0; l < n_labels; ++l)
+                received_labels[l][k] = from.second[at++];
             }
-        device->append_points(received);
-        labels = std::move(new_labels);
+        device->append_points(received, received_labels);
+        labels_on_device_only = true;
         p.n_sent += leaving.size();
         handler_behind = true;
         return static_cast<unsigned int>(dropped);
@@ -235,10 +221,24 @@ namespace mpm
         return shared_grid == nullptr ? -1 : exchange_seconds_before + device->exchange_seconds();
       }
 
+      double exchange_host_seconds() override
+      {
+        return shared_grid == nullptr ? -1 : exchange_host_seconds_before + exchange->host_seconds();
+      }
+
       void load(const HostPoints<dim, double> &p, std::shared_ptr<const PointLabels<dim>> new_labels) override
       {
         labels = std::move(new_labels); // a snapshot being written keeps the old ones
         device->upload_points(p);
+        labels_on_device_only = false;
+        if (shared_grid == nullptr)
+          return;
+        // Several ranks: the labels travel with the points at re-sorts, on the device.
+        std::vector<std::vector<double>> arrays(1 + dim);
+        arrays[0].assign(labels->id.begin(), labels->id.end());
+        for (int d = 0; d < dim; ++d)
+          arrays[1 + d] = labels->initial_position[d];
+        device->upload_labels(arrays);
       }
 
       // Hand-over to the handler (an MPI re-sort): points come back, points that left the
@@ -258,6 +258,19 @@ namespace mpm
       {
         s.points.resize(device->n_points());
         device->download_points(s.points);
+        if (labels_on_device_only)
+          {
+            // Re-sorts moved the labels on the device: they come down in upload order.
+            std::vector<std::vector<double>> arrays;
+            device->download_labels(arrays);
+            auto now                  = std::make_shared<PointLabels<dim>>();
+            now->state_variable_names = labels->state_variable_names;
+            now->id.assign(arrays[0].begin(), arrays[0].end()); // ids below 2^53 are exact in a double
+            for (int d = 0; d < dim; ++d)
+              now->initial_position[d] = std::move(arrays[1 + d]);
+            labels                = std::move(now); // a snapshot being written keeps the old ones
+            labels_on_device_only = false;
+          }
         s.labels = labels;
       }
 
@@ -299,12 +312,15 @@ namespace mpm
       // The partition the device's nodes were built for (kept alive, so a new one cannot
       // reuse its address).
       std::shared_ptr<const dealii::Utilities::MPI::Partitioner> built_for;
-      double                                  exchange_seconds_before = 0; // on devices since rebuilt
+      double exchange_seconds_before = 0, exchange_host_seconds_before = 0; // on devices since rebuilt
       std::unique_ptr<GridExchange<dim>>      exchange; // declared before device: outlives it
       std::unique_ptr<cuda::DeviceEngine<dim>> device;
       HostPoints<dim, double>                 host;       // staging for load/store from the handler only
       std::vector<long>                       home_cells; // several ranks: lattice cell of each point at load
       std::shared_ptr<const PointLabels<dim>> labels;     // id, initial position, in the uploaded order
+      // Several ranks: a re-sort has changed the points since `labels` was made; the device's
+      // labels are the current ones.
+      bool labels_on_device_only = false;
       // Several ranks: the owner of each owned or ghost lattice cell (-1 elsewhere), and
       // whether resort() has moved points since the handler last saw them.
       std::vector<int> owner_of_cell;
@@ -320,7 +336,10 @@ namespace mpm
       void build_on_grid()
       {
         if (device != nullptr)
-          exchange_seconds_before += device->exchange_seconds();
+          {
+            exchange_seconds_before += device->exchange_seconds();
+            exchange_host_seconds_before += exchange->host_seconds();
+          }
         device.reset();
         exchange  = std::make_unique<GridExchange<dim>>(*shared_grid);
         built_for = shared_grid->partitioner;

@@ -475,10 +475,12 @@ namespace mpm
                 << static_cast<long>(max(ghosts, s.communicator)) << " at most on one rank; exchange " << bytes
                 << " bytes per step (" << arrays << " nodal arrays, each ghost value sent to its owner and back)\n";
         const double exchange = max(s.engine->exchange_seconds(), s.communicator);
+        const double host_part = max(s.engine->exchange_host_seconds(), s.communicator);
         if (exchange >= 0 && steps > 0)
           s.pcout << "  GPU ghost exchange: " << exchange << " s on the slowest rank, " << 1e3 * exchange / steps
                   << " ms per step (device time from the end of each P2G to the sums in place: the copies, the "
-                     "host's part and MPI)\n";
+                     "host's part and MPI), of which the host's part "
+                  << 1e3 * host_part / steps << " ms per step (copies into the partitioner's layout and MPI)\n";
       }
     s.pcout << "  output: " << s.output->n_outputs() << " outputs, " << s.output->task_seconds()
             << " s building and writing files on rank 0";

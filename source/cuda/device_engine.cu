@@ -13,6 +13,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <limits>
 #include <stdexcept>
 #include <type_traits>
 #include <utility>
@@ -228,6 +229,7 @@ namespace mpm
       {
         DeviceArray<std::uint8_t> keep_flag, leave_flag;
         DeviceArray<int>          slot, kept_slots, leaving_slots, index, counts;
+        DeviceArray<double>       leaving_labels; // packed: label array k of leaving point j at k * m + j
         DeviceArray<char>         temp; // CUB's
       };
 
@@ -356,14 +358,16 @@ namespace mpm
       Staging<long>                exchanged_cells;
       ExchangeAdapter              exchange;
       DeviceArray<long>            home_cells; // several ranks: in upload order
+      std::vector<DeviceArray<double>> labels; // several ranks: ids, initial positions; in upload order
       DeviceArray<std::uint8_t>    owned_cells; // several ranks: 1 for each lattice cell this rank owns
       // The re-sort's (take_leaving_points) flags, slot lists and gathers' scratch: kept
       // between re-sorts.
       ResortScratch                resort;
       SlotScratch                  slot_scratch;
-      // The device numbers its nodes in lattice order (one rank, the host's nodes being the
-      // whole lattice); otherwise as the host does.
-      bool                         lattice_order = false;
+      // The device's nodes: lattice order from lattice index node_offset on; the device
+      // index of each host node (-1: not in the lattice).
+      long                         node_offset = 0;
+      std::vector<int>             slab_of_host;
       // The last step's pressure averaging is left to the next step's P2G (explicit_step);
       // download_points finishes it first.
       bool                         averaging_pending = false;
@@ -401,51 +405,65 @@ namespace mpm
           n_lattice_nodes *= g.n_cells[d] + 1;
           impl->n_lattice_cells *= g.n_cells[d];
         }
-      // Without an exchange the device may number its nodes as it likes. Where the host's
-      // nodes are the whole lattice (one rank), the device keeps them in lattice order (x
-      // fastest; deal.II numbers the DoFs cell by cell): its grid view then needs no lookup,
-      // a node's index is its lattice index (DeviceGrid::lattice_order; 6% off P1's step).
-      // download_nodal puts the values back in the order of the host grid it is given.
-      std::vector<int> lattice_nodes(g.lattice_to_node, g.lattice_to_node + n_lattice_nodes);
-      bool             bijection = exchange == nullptr && g.n_nodes == n_lattice_nodes;
-      std::vector<char> seen(bijection ? g.n_nodes : 0, 0);
-      for (long l = 0; bijection && l < n_lattice_nodes; ++l)
-        {
-          const int node = lattice_nodes[l];
-          bijection      = node >= 0 && node < g.n_nodes && !seen[node];
-          if (bijection)
-            seen[node] = 1;
-        }
-      host.allocate_nodes(g.n_nodes);
-      if (bijection)
-        {
-          impl->lattice_order = true;
-          host.lattice_to_node.resize(n_lattice_nodes);
-          for (long l = 0; l < n_lattice_nodes; ++l)
-            {
-              host.lattice_to_node[l]     = static_cast<int>(l);
-              host.fixed_components[l] = g.fixed_components[lattice_nodes[l]];
-            }
-        }
-      else
-        {
-          host.lattice_to_node = lattice_nodes;
-          host.fixed_components.assign(g.fixed_components, g.fixed_components + g.n_nodes);
-        }
+      // The device numbers its nodes in lattice order (x fastest; deal.II numbers its DoFs
+      // cell by cell), so that its grid view needs no lookup and the atomics of neighbouring
+      // points hit neighbouring addresses (DeviceGrid::lattice_order; 6% off P1's step on
+      // one rank). It keeps the slab of whole lattice layers, along the last direction,
+      // that holds every host node: the lattice on one rank, the rank's part and its ghost
+      // layers on several (a slab node the host does not hold stays massless: no point of
+      // the rank reaches it). download_nodal and the exchange translate to the host's
+      // numbering.
+      const long       layer = n_lattice_nodes / (g.n_cells[dim - 1] + 1);
+      std::vector<int> lattice_nodes(n_lattice_nodes);
+      for (long l = 0; l < n_lattice_nodes; ++l)
+        lattice_nodes[l] = g.node_of_lattice(l);
+      long             first = -1, last = -1;
+      std::vector<long> lattice_of_host(g.n_nodes, -1);
+      for (long l = 0; l < n_lattice_nodes; ++l)
+        if (const int node = lattice_nodes[l]; node >= 0)
+          {
+            if (node >= g.n_nodes || lattice_of_host[node] >= 0)
+              throw std::invalid_argument("DeviceEngine: the host grid's lattice lookup is not one to one");
+            lattice_of_host[node] = l;
+            first                 = first < 0 ? l : first;
+            last                  = l;
+          }
+      const long node_offset = first < 0 ? 0 : first / layer * layer;
+      const long n_slab      = first < 0 ? 0 : (last / layer + 1) * layer - node_offset;
+      if (n_slab > std::numeric_limits<int>::max())
+        throw std::invalid_argument("DeviceEngine: more lattice nodes in the rank's slab than an int can count");
+      impl->node_offset = node_offset;
+      impl->slab_of_host.resize(g.n_nodes);
+      for (int node = 0; node < g.n_nodes; ++node)
+        impl->slab_of_host[node] = lattice_of_host[node] < 0 ? -1 : static_cast<int>(lattice_of_host[node] - node_offset);
+      host.allocate_nodes(static_cast<int>(n_slab));
+      host.fixed_components.assign(n_slab, 0);
+      for (long b = 0; b < n_slab; ++b)
+        if (const int node = lattice_nodes[node_offset + b]; node >= 0)
+          host.fixed_components[b] = g.fixed_components[node];
       if (g.friction_faces != nullptr)
         {
-          host.friction_faces.resize(g.n_nodes);
-          for (int n = 0; n < g.n_nodes; ++n)
-            host.friction_faces[n] = g.friction_faces[bijection ? lattice_nodes[n] : n];
+          host.friction_faces.assign(n_slab, 0);
+          for (long b = 0; b < n_slab; ++b)
+            if (const int node = lattice_nodes[node_offset + b]; node >= 0)
+              host.friction_faces[b] = g.friction_faces[node];
           for (int f = 0; f < 2 * dim; ++f)
             host.friction_coefficient[f] = g.friction_coefficient[f];
         }
-      impl->grid.upload(host);
+      impl->grid.upload(host); // no lookup: lattice order from node_offset on
+      impl->grid.node_offset = node_offset;
       impl->materials.upload(materials);
       impl->exchange = ExchangeAdapter{exchange, &impl->backend, &impl->exchanged_nodes, &impl->exchanged_cells};
       if (exchange != nullptr)
         {
-          impl->exchanged_nodes.set_index(exchange->exchanged_nodes());
+          std::vector<int> slab_nodes = exchange->exchanged_nodes();
+          for (int &node : slab_nodes)
+            {
+              node = node >= 0 && node < g.n_nodes ? impl->slab_of_host[node] : -1;
+              if (node < 0)
+                throw std::invalid_argument("DeviceEngine: an exchanged node is not in the host grid's lattice");
+            }
+          impl->exchanged_nodes.set_index(slab_nodes);
           impl->exchanged_cells.set_index(exchange->exchanged_cells());
         }
     }
@@ -459,6 +477,7 @@ namespace mpm
       impl->points.upload(p);
       impl->order.reset(impl->backend, impl->points.size());
       impl->home_cells.resize(0); // set_home_cells gives those of these points
+      impl->labels.clear();       // upload_labels gives those of these points
       impl->steps_since_upload = 0;
       impl->averaging_pending  = false; // the host's stresses are final
     }
@@ -488,22 +507,20 @@ namespace mpm
     {
       impl->backend.synchronize();
       const DeviceGrid<dim, double> &dg = impl->grid;
-      const size_t bytes = dg.mass.bytes();
-      if (static_cast<size_t>(g.n_nodes) != dg.mass.size())
-        throw std::invalid_argument("DeviceEngine::download_nodal: the host grid has another number of nodes");
-      // Lattice order on the device: device node l is the host's node g.lattice_to_node[l]
-      // (the identity where the host grid has no lookup).
-      const int          *host_node = impl->lattice_order ? g.lattice_to_node : nullptr;
-      std::vector<double> staging(host_node == nullptr ? 0 : dg.mass.size());
+      for (int d = 0; d < dim; ++d)
+        if (g.n_cells[d] != dg.n_cells[d])
+          throw std::invalid_argument("DeviceEngine::download_nodal: the host grid has another lattice");
+      // Device node b is lattice node node_offset + b, which is the host's node of that
+      // lattice index (absent from the host: not written).
+      std::vector<double> staging(dg.mass.size());
+      std::vector<int>    host_node(staging.size());
+      for (size_t b = 0; b < host_node.size(); ++b)
+        host_node[b] = g.node_of_lattice(impl->node_offset + static_cast<long>(b));
       auto download = [&](double *to, const DeviceArray<double> &from) {
-        if (host_node == nullptr)
-          {
-            MPM_CUDA_CHECK(cudaMemcpy(to, from.data(), bytes, cudaMemcpyDeviceToHost));
-            return;
-          }
-        MPM_CUDA_CHECK(cudaMemcpy(staging.data(), from.data(), bytes, cudaMemcpyDeviceToHost));
-        for (size_t k = 0; k < staging.size(); ++k)
-          to[host_node[k]] = staging[k];
+        from.download(staging);
+        for (size_t b = 0; b < staging.size(); ++b)
+          if (host_node[b] >= 0)
+            to[host_node[b]] = staging[b];
       };
       // Mass and velocity only: the nodal fields that the output writes (a quarter of the
       // bytes of all four arrays; after the step, force[] holds G2P's blended vector).
@@ -580,6 +597,27 @@ namespace mpm
     }
 
     template <int dim>
+    void DeviceEngine<dim>::upload_labels(const std::vector<std::vector<double>> &labels)
+    {
+      impl->labels.resize(labels.size());
+      for (std::size_t k = 0; k < labels.size(); ++k)
+        {
+          if (static_cast<int>(labels[k].size()) != impl->points.size())
+            throw std::invalid_argument("DeviceEngine::upload_labels: one label per uploaded point is needed");
+          impl->labels[k].upload(labels[k]);
+        }
+    }
+
+    template <int dim>
+    void DeviceEngine<dim>::download_labels(std::vector<std::vector<double>> &labels) const
+    {
+      impl->backend.synchronize();
+      labels.resize(impl->labels.size());
+      for (std::size_t k = 0; k < labels.size(); ++k)
+        impl->labels[k].download(labels[k]);
+    }
+
+    template <int dim>
     void DeviceEngine<dim>::set_home_cells(const std::vector<long> &home_cells)
     {
       if (static_cast<int>(home_cells.size()) != impl->points.size())
@@ -616,8 +654,8 @@ namespace mpm
     }
 
     template <int dim>
-    int DeviceEngine<dim>::take_leaving_points(HostPoints<dim, double> &leaving, std::vector<int> &leaving_index,
-                                               std::vector<int> &kept_index)
+    int DeviceEngine<dim>::take_leaving_points(HostPoints<dim, double>          &leaving,
+                                               std::vector<std::vector<double>> &leaving_labels)
     {
       if (static_cast<long>(impl->owned_cells.size()) != impl->n_lattice_cells)
         throw std::logic_error("DeviceEngine::take_leaving_points: the owned cells are not known");
@@ -673,22 +711,45 @@ namespace mpm
       r.kept_slots.resize(n_kept);
       r.leaving_slots.resize(n_leaving);
 
-      // Their upload-order indices: original[slot].
+      // The labels, in upload order: those of the points that stay are gathered on the
+      // device (original[slot] is a slot's upload-order index), those of the leaving points
+      // come down packed in one copy.
       const int *original = impl->order.original_index();
-      auto       download_original = [&](const DeviceArray<int> &slots, std::vector<int> &index) {
+      auto       upload_order_of = [&](const DeviceArray<int> &slots) {
         const int m = static_cast<int>(slots.size());
         r.index.resize(m);
-        index.resize(m);
-        if (m == 0)
-          return;
         const int *from = slots.data();
         int       *to   = r.index.data();
-        impl->backend.for_each_node(m, [=] MPM_HOST_DEVICE(const int k) { to[k] = original[from[k]]; });
-        MPM_CUDA_CHECK(cudaMemcpyAsync(index.data(), to, m * sizeof(int), cudaMemcpyDeviceToHost, stream));
-        MPM_CUDA_CHECK(cudaStreamSynchronize(stream));
+        if (m > 0)
+          impl->backend.for_each_node(m, [=] MPM_HOST_DEVICE(const int k) { to[k] = original[from[k]]; });
       };
-      download_original(r.kept_slots, kept_index);
-      download_original(r.leaving_slots, leaving_index);
+      const int n_labels = static_cast<int>(impl->labels.size());
+      upload_order_of(r.leaving_slots);
+      r.leaving_labels.resize(static_cast<std::size_t>(n_labels) * n_leaving);
+      for (int k = 0; k < n_labels && n_leaving > 0; ++k)
+        {
+          gather_slots_kernel<double><<<(n_leaving + 255) / 256, 256, 0, stream>>>(
+            n_leaving, r.index.data(), impl->labels[k].data(), r.leaving_labels.data() + k * n_leaving);
+          MPM_CUDA_CHECK_LAUNCH();
+        }
+      std::vector<double> packed_labels;
+      r.leaving_labels.download(packed_labels); // waits for the gathers
+      leaving_labels.resize(n_labels);
+      for (int k = 0; k < n_labels; ++k)
+        leaving_labels[k].assign(packed_labels.begin() + k * n_leaving, packed_labels.begin() + (k + 1) * n_leaving);
+      upload_order_of(r.kept_slots);
+      for (DeviceArray<double> &array : impl->labels)
+        {
+          DeviceArray<double> &gathered = impl->slot_scratch.reals;
+          gathered.resize(n_kept);
+          if (n_kept > 0)
+            {
+              gather_slots_kernel<double>
+                <<<(n_kept + 255) / 256, 256, 0, stream>>>(n_kept, r.index.data(), array.data(), gathered.data());
+              MPM_CUDA_CHECK_LAUNCH();
+            }
+          array.swap(gathered);
+        }
       const int n_dropped = n - n_kept - n_leaving;
       take_slots<dim>(impl->points, r.leaving_slots, leaving, impl->slot_scratch, stream);
       keep_slots<dim>(impl->points, r.kept_slots, impl->slot_scratch, stream);
@@ -697,13 +758,25 @@ namespace mpm
     }
 
     template <int dim>
-    void DeviceEngine<dim>::append_points(const HostPoints<dim, double> &added)
+    void DeviceEngine<dim>::append_points(const HostPoints<dim, double>          &added,
+                                          const std::vector<std::vector<double>> &added_labels)
     {
       const int          m      = impl->points.size();
       const int          r      = added.size();
       const cudaStream_t stream = impl->backend.get_stream();
       if (added.n_state_variables() != 0)
         throw std::invalid_argument("DeviceEngine::append_points: the device holds no state variables");
+      if (added_labels.size() != impl->labels.size())
+        throw std::invalid_argument("DeviceEngine::append_points: not as many label arrays as were uploaded");
+      for (std::size_t k = 0; k < added_labels.size(); ++k)
+        {
+          if (static_cast<int>(added_labels[k].size()) != r)
+            throw std::invalid_argument("DeviceEngine::append_points: one label per added point is needed");
+          impl->labels[k].resize_preserving(m + r, stream);
+          if (r > 0)
+            MPM_CUDA_CHECK(cudaMemcpyAsync(impl->labels[k].data() + m, added_labels[k].data(), r * sizeof(double),
+                                           cudaMemcpyHostToDevice, stream));
+        }
       // In place where the memory held allows (it grows by an eighth when it does not).
       for_each_point_array<dim>(impl->points, added, [&](auto &array, const auto &tail) {
         using T = typename std::decay_t<decltype(array)>::value_type;

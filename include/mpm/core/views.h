@@ -36,10 +36,12 @@ namespace mpm
     Real origin[dim];           // lower corner of the grid
     Real h;                     // cell size, equal in every direction
     int  n_cells[dim];          // cells per direction
-    // Lattice index -> local node index, -1 if absent. Null: the nodes are the whole
-    // lattice in lattice order (device grids on one rank), no lookup needed.
+    // Lattice index -> local node index, -1 if absent. Null: the nodes are a slab of the
+    // lattice in lattice order, no lookup needed (device grids): node = lattice index -
+    // node_offset, and a lattice index outside the slab is absent.
     const int *lattice_to_node;
     int        n_nodes;         // local nodes (length of the arrays below)
+    long       node_offset = 0; // without a lookup: lattice index of node 0
 
     Real *mass;
     Real *momentum[dim];
@@ -89,7 +91,11 @@ namespace mpm
     // Local node index of a lattice index inside the lattice.
     MPM_HOST_DEVICE int node_of_lattice(const long lattice) const
     {
-      return lattice_to_node != nullptr ? lattice_to_node[lattice] : static_cast<int>(lattice);
+      if (lattice_to_node != nullptr)
+        return lattice_to_node[lattice];
+      // One compare for both ends of the slab (a negative difference wraps to a large one).
+      const unsigned long node = static_cast<unsigned long>(lattice - node_offset);
+      return node < static_cast<unsigned long>(n_nodes) ? static_cast<int>(node) : -1;
     }
   };
 

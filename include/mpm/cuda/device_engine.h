@@ -102,19 +102,25 @@ namespace mpm
       void   set_home_cells(const std::vector<long> &home_cells);
       double max_distance_outside_home_cells();
 
+      // Several ranks: values that travel with each point but that the step does not use
+      // (the host's ids and initial positions), arrays of n_points() entries in upload
+      // order. They stay on the device, so that a re-sort moves them there too; upload
+      // them after each upload_points.
+      void upload_labels(const std::vector<std::vector<double>> &labels);
+      void download_labels(std::vector<std::vector<double>> &labels) const;
+
       // Several ranks: the MPI re-sort on the device, where only the points that change
       // rank cross the bus. set_owned_cells: 1 for each lattice cell this rank owns (once
       // per partition). take_leaving_points applies a pending pressure averaging, then
       // splits the points by their current cell: those in other ranks' cells come down
-      // into `leaving` (leaving_index: their upload-order index), those that left the grid
-      // are dropped (the count is returned), the others stay in their current order
-      // (kept_index: upload-order index of each). append_points adds the points received
-      // from other ranks at the end. After it, the device's order is the new upload order
-      // and every point's home cell is its current cell.
+      // into `leaving` with their labels, those that left the grid are dropped (the count
+      // is returned), the others stay in their current order with their labels.
+      // append_points adds the points received from other ranks, with their labels, at the
+      // end. After it, the device's order is the new upload order and every point's home
+      // cell is its current cell.
       void set_owned_cells(const std::vector<std::uint8_t> &owned);
-      int  take_leaving_points(HostPoints<dim, double> &leaving, std::vector<int> &leaving_index,
-                               std::vector<int> &kept_index);
-      void append_points(const HostPoints<dim, double> &points);
+      int  take_leaving_points(HostPoints<dim, double> &leaving, std::vector<std::vector<double>> &leaving_labels);
+      void append_points(const HostPoints<dim, double> &points, const std::vector<std::vector<double>> &labels);
 
       int n_points() const;
 

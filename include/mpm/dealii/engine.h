@@ -61,6 +61,8 @@ namespace mpm
     // several ranks: from the end of the work before each exchange to its sums in place);
     // negative where the engine does not measure them.
     virtual double exchange_seconds() { return -1; }
+    // Of those, the seconds the host spent in them (copies and MPI); negative where not measured.
+    virtual double exchange_host_seconds() { return -1; }
     // Steps between re-sorts of the points (Backend/Sort interval); engines that do not
     // re-sort ignore it.
     virtual void set_sort_interval(int /*steps*/) {}

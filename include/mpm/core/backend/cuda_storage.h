@@ -169,10 +169,12 @@ namespace mpm
           force[d].upload(g.force[d]);
           velocity[d].upload(g.velocity[d]);
         }
-      lattice_to_node.upload(g.lattice_to_node);
-      lattice_order = g.lattice_to_node.size() == g.mass.size();
-      for (size_t l = 0; lattice_order && l < g.lattice_to_node.size(); ++l)
+      // No lookup where the host's is the identity, or where it has none (a slab of the
+      // lattice starting at node_offset, which the owner sets).
+      lattice_order = g.lattice_to_node.empty() || g.lattice_to_node.size() == g.mass.size();
+      for (size_t l = 0; !g.lattice_to_node.empty() && lattice_order && l < g.lattice_to_node.size(); ++l)
         lattice_order = g.lattice_to_node[l] == static_cast<int>(l);
+      lattice_to_node.upload(lattice_order ? std::vector<int>() : g.lattice_to_node);
       mass.upload(g.mass);
       fixed_components.upload(g.fixed_components);
       friction_faces.upload(g.friction_faces);
@@ -192,14 +194,19 @@ namespace mpm
       mass.download(g.mass);
     }
 
-    // Whether the lookup is the identity over the whole lattice (the view then has none).
+    // Whether the nodes are a slab of the lattice in lattice order, from lattice index
+    // node_offset on (the view then has no lookup).
     bool lattice_order = false;
+    long node_offset   = 0;
 
     GridView<dim, Real> view()
     {
       GridView<dim, Real> v = make_grid_view<dim, Real>(*this);
       if (lattice_order)
-        v.lattice_to_node = nullptr;
+        {
+          v.lattice_to_node = nullptr;
+          v.node_offset     = node_offset;
+        }
       return v;
     }
   };
