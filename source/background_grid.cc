@@ -253,34 +253,16 @@ namespace mpm
     return 2 * sizeof(double) * partitioner->n_ghost_indices();
   }
 
-  namespace
-  {
-    // Ghost entries and import entries (ranges of owned ones) of a partitioner, ascending.
-    std::vector<unsigned int> touched_by_exchange(const dealii::Utilities::MPI::Partitioner &partitioner)
-    {
-      std::vector<unsigned int> local;
-      for (const auto &range : partitioner.import_indices())
-        for (unsigned int i = range.first; i < range.second; ++i)
-          local.push_back(i);
-      std::sort(local.begin(), local.end());
-      local.erase(std::unique(local.begin(), local.end()), local.end());
-      const unsigned int n_owned = partitioner.locally_owned_size();
-      for (unsigned int g = 0; g < partitioner.n_ghost_indices(); ++g)
-        local.push_back(n_owned + g);
-      return local;
-    }
-  } // namespace
-
   template <int dim>
   std::vector<unsigned int> BackgroundGrid<dim>::exchanged_local_nodes() const
   {
-    return touched_by_exchange(*partitioner);
+    return InterleavedExchange::packed_indices(*partitioner);
   }
 
   template <int dim>
   std::vector<unsigned int> BackgroundGrid<dim>::exchanged_local_cells() const
   {
-    return touched_by_exchange(*cell_partitioner);
+    return InterleavedExchange::packed_indices(*cell_partitioner);
   }
 
   template <int dim>
@@ -289,6 +271,20 @@ namespace mpm
   {
     if (n_ranks > 1)
       cell_exchange.sum(cell_partitioner, arrays, count);
+  }
+
+  template <int dim>
+  void BackgroundGrid<dim>::sum_packed_nodes(double *values, const int count) const
+  {
+    if (n_ranks > 1)
+      node_exchange.sum_packed(partitioner, values, count);
+  }
+
+  template <int dim>
+  void BackgroundGrid<dim>::sum_packed_cells(double *values, const int count) const
+  {
+    if (n_ranks > 1)
+      cell_exchange.sum_packed(cell_partitioner, values, count);
   }
 
   namespace

@@ -26,10 +26,11 @@ namespace mpm
 #ifdef MPM_CUDA_ENGINE
   namespace
   {
-    // The host side of the device's nodal exchange on several ranks: the packed ghost and
-    // import entries go into the partitioner's local layout (host scratch, only those
-    // entries are read or written), deal.II's Partitioner sums them over the ranks
-    // (BackgroundGrid::Exchange), and the sums go back into the packed array.
+    // The host side of the device's nodal exchange on several ranks: the device packs the
+    // exchanged entries in the order of the grid's exchanged_local_nodes() (cells:
+    // exchanged_local_cells()), entry by entry, and deal.II's Partitioner sums them over the
+    // ranks from there (BackgroundGrid::sum_packed_nodes: only the owned entries are copied
+    // on the host, the ghosts go to MPI from the packed buffer itself).
     template <int dim>
     class GridExchange : public cuda::NodalExchange
     {
@@ -38,8 +39,6 @@ namespace mpm
         : grid(grid)
         , nodes(grid.exchanged_local_nodes())
         , cells(grid.exchanged_local_cells())
-        , n_local_nodes(grid.partitioner->locally_owned_size() + grid.partitioner->n_ghost_indices())
-        , n_local_cells(grid.cell_partitioner->locally_owned_size() + grid.cell_partitioner->n_ghost_indices())
       {}
 
       std::vector<int> exchanged_nodes() const override { return std::vector<int>(nodes.begin(), nodes.end()); }
@@ -54,51 +53,28 @@ namespace mpm
 
       void sum_nodal(double *values, const int count) override
       {
-        sum(values, count, nodes, n_local_nodes,
-            [this](double *const *arrays, const int c) { grid.exchange().sum_nodal(arrays, c); });
+        timed([&] { grid.sum_packed_nodes(values, count); });
       }
 
       void sum_cells(double *values, const int count) override
       {
-        sum(values, count, cells, n_local_cells,
-            [this](double *const *arrays, const int c) { grid.sum_local_cells(arrays, c); });
+        timed([&] { grid.sum_packed_cells(values, count); });
       }
 
-      // Bytes one rank moves between device and host per array of one exchange (each way).
-      std::size_t staged_bytes_per_array() const { return sizeof(double) * nodes.size(); }
-
-      // The host's part of the exchanges so far: the copies into and out of the
-      // partitioner's layout and the partitioner's MPI.
+      // The host's part of the exchanges so far: the copies of the owned entries and the
+      // partitioner's MPI.
       double host_seconds() const { return seconds; }
 
     private:
       const BackgroundGrid<dim>       &grid;
       const std::vector<unsigned int> nodes, cells;
-      const std::size_t               n_local_nodes, n_local_cells;
-      std::vector<double>             scratch;
       double                          seconds = 0;
 
-      template <typename Exchange>
-      void sum(double *values, const int count, const std::vector<unsigned int> &local, const std::size_t n_local,
-               Exchange &&exchange)
+      template <typename Work>
+      void timed(Work &&work)
       {
         const auto start = std::chrono::steady_clock::now();
-        const std::size_t n = local.size();
-        // Only grows: the two exchanges of a step carry different numbers of arrays, and a
-        // vector growing back zero-fills its new part (8 MB a step on P1's 1.6M-point ranks).
-        if (scratch.size() < count * n_local)
-          scratch.resize(count * n_local);
-        std::vector<double *> arrays(count);
-        for (int k = 0; k < count; ++k)
-          {
-            arrays[k] = scratch.data() + k * n_local;
-            for (std::size_t j = 0; j < n; ++j)
-              arrays[k][local[j]] = values[k * n + j];
-          }
-        exchange(arrays.data(), count);
-        for (int k = 0; k < count; ++k)
-          for (std::size_t j = 0; j < n; ++j)
-            values[k * n + j] = arrays[k][local[j]];
+        work();
         seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       }
     };

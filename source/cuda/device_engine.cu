@@ -68,7 +68,8 @@ namespace mpm
 
     namespace
     {
-      // Pack and unpack of the exchanged entries: values[k * n + j] = arrays[k][index[j]].
+      // Pack and unpack of the exchanged entries, entry by entry (the host's MPI buffers'
+      // layout): values[j * count + k] = arrays[k][index[j]].
       constexpr int max_exchanged_arrays = 8;
       struct ArrayList
       {
@@ -81,7 +82,7 @@ namespace mpm
         const long j = blockIdx.x * static_cast<long>(blockDim.x) + threadIdx.x;
         if (j >= n * count)
           return;
-        values[j] = arrays.array[j / n][index[j % n]];
+        values[j] = arrays.array[j % count][index[j / count]];
       }
       template <typename Index>
       __global__ void unpack_kernel(const long n, const int count, const Index *index, const double *values,
@@ -90,7 +91,7 @@ namespace mpm
         const long j = blockIdx.x * static_cast<long>(blockDim.x) + threadIdx.x;
         if (j >= n * count)
           return;
-        arrays.array[j / n][index[j % n]] = values[j];
+        arrays.array[j % count][index[j / count]] = values[j];
       }
 
       // One kind of exchanged entries (nodes or cells): their indices on the device, the

@@ -5,7 +5,8 @@
 //   array alone. Values are small integers, so every sum is exact whatever its order: the
 //   comparison is exact;
 // - against the Partitioner's exchange of one array at a time, on random values: equal to the
-//   bit (the sums are added in the same order).
+//   bit (the sums are added in the same order);
+// - sum_packed (the GPU engine's path) against sum(): the same bits at every exchanged entry.
 // Counts 1, 3 and 7 (MUSL's first exchange), double and float, a repartitioned grid, in 2D
 // and 3D; meant for 1 to 4 ranks.
 #include <mpm/dealii/interleaved_exchange.h>
@@ -129,6 +130,49 @@ namespace
                   differing == 0 ? "ok  " : "FAIL", what, count, sizeof(Real) == 8 ? "double" : "float", differing);
   }
 
+  // sum_packed (the GPU engine's path: only the exchanged entries, packed entry by entry)
+  // against sum() on the whole arrays: the same bits at every exchanged entry.
+  template <typename Real>
+  void check_packed(const std::shared_ptr<const Utilities::MPI::Partitioner> &partitioner,
+                    mpm::InterleavedExchange &exchange, const int count, const char *what)
+  {
+    const MPI_Comm     comm    = partitioner->get_mpi_communicator();
+    const unsigned int rank    = Utilities::MPI::this_mpi_process(comm);
+    const std::size_t  n_local = partitioner->locally_owned_size() + partitioner->n_ghost_indices();
+    std::mt19937       random(4321 + rank);
+    std::uniform_real_distribution<double> value(-1, 1);
+    std::vector<std::vector<Real>> arrays(count, std::vector<Real>(n_local));
+    std::vector<Real *>            pointers(count);
+    for (int k = 0; k < count; ++k)
+      {
+        for (Real &v : arrays[k])
+          v = static_cast<Real>(value(random));
+        pointers[k] = arrays[k].data();
+      }
+    const std::vector<unsigned int> packed_at = mpm::InterleavedExchange::packed_indices(*partitioner);
+    std::vector<Real>               packed(packed_at.size() * count);
+    for (std::size_t j = 0; j < packed_at.size(); ++j)
+      for (int k = 0; k < count; ++k)
+        packed[j * count + k] = arrays[k][packed_at[j]];
+    exchange.sum(partitioner, pointers.data(), count);
+    exchange.sum_packed(partitioner, packed.data(), count);
+    // Every entry the exchange changes must be among the packed ones.
+    long differing = 0, missing = 0;
+    std::vector<char> is_packed(n_local, 0);
+    for (const unsigned int i : packed_at)
+      is_packed[i] = 1;
+    for (std::size_t i = partitioner->locally_owned_size(); i < n_local; ++i)
+      missing += is_packed[i] ? 0 : 1;
+    for (std::size_t j = 0; j < packed_at.size(); ++j)
+      for (int k = 0; k < count; ++k)
+        differing += std::memcmp(&packed[j * count + k], &arrays[k][packed_at[j]], sizeof(Real)) != 0 ? 1 : 0;
+    differing = Utilities::MPI::sum(differing + missing, comm);
+    failures += differing == 0 ? 0 : 1;
+    if (rank == 0)
+      std::printf("%s %s, %d array(s), %s, packed: %ld entries differ from sum() or are not packed\n",
+                  differing == 0 ? "ok  " : "FAIL", what, count, sizeof(Real) == 8 ? "double" : "float", differing);
+  }
+
   template <int dim>
   void run(const MPI_Comm comm)
   {
@@ -157,6 +201,9 @@ namespace
         check_bitwise<double>(node_partitioner, nodes, 7, (grid + ", nodes").c_str());
         check_bitwise<double>(cell_partitioner, cells, 2, (grid + ", cells").c_str());
         check_bitwise<float>(node_partitioner, nodes, 3, (grid + ", nodes").c_str());
+        check_packed<double>(node_partitioner, nodes, 7, (grid + ", nodes").c_str());
+        check_packed<double>(cell_partitioner, cells, 2, (grid + ", cells").c_str());
+        check_packed<double>(node_partitioner, nodes, 1, (grid + ", nodes").c_str());
         // Refine a corner and let p4est repartition: new numbering, new neighbours.
         for (const auto &cell : triangulation.active_cell_iterators())
           if (cell->is_locally_owned() && cell->center()[0] < 0.2)

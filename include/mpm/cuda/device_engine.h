@@ -55,8 +55,8 @@ namespace mpm
       virtual ~NodalExchange() = default;
       // Node indices (the host grid's numbering) that sum_nodal reads and writes.
       virtual std::vector<int> exchanged_nodes() const = 0;
-      // values[k * n + j] is array k at exchanged_nodes()[j] (n of them); on return, the
-      // sums over the ranks.
+      // values[j * count + k] is array k at exchanged_nodes()[j] (entry by entry); on
+      // return, the sums over the ranks.
       virtual void sum_nodal(double *values, int count) = 0;
       // The same for the pressure averaging's cell arrays, indexed by lattice cell.
       virtual std::vector<long> exchanged_cells() const = 0;

@@ -87,15 +87,19 @@ namespace mpm
     std::size_t exchange_bytes_per_array() const;
 
     // For an engine whose arrays live elsewhere (the GPU) and come to the host only for the
-    // exchange. Nodes: the local indices that sum_nodal reads or writes (every ghost node and
-    // the owned nodes that other ranks hold as ghosts), ascending. Cells: the same in the cell
-    // partitioner's local numbering, and the lattice cell of each local cell.
+    // exchange. Nodes: the local indices that sum_nodal reads or writes (the owned nodes that
+    // other ranks hold as ghosts, ascending, then every ghost node). Cells: the same in the
+    // cell partitioner's local numbering, and the lattice cell of each local cell.
     std::vector<unsigned int> exchanged_local_nodes() const;
     std::vector<unsigned int> exchanged_local_cells() const;
     long lattice_cell_of_local_cell(unsigned int local_cell) const { return lattice_cell_of_local_cell_index[local_cell]; }
     // sum_cells on arrays laid out as the cell partitioner's local storage (owned, then ghosts).
     template <typename Real>
     void sum_local_cells(Real *const *arrays, int count) const;
+    // The sums on those entries only, packed entry by entry: values[j * count + k] is array
+    // k at exchanged_local_nodes()[j] (exchanged_local_cells()[j]); InterleavedExchange::sum_packed.
+    void sum_packed_nodes(double *values, int count) const;
+    void sum_packed_cells(double *values, int count) const;
 
     MPI_Comm                                  communicator;
     unsigned int                              n_ranks;

@@ -27,13 +27,34 @@ namespace mpm
     void sum(const std::shared_ptr<const dealii::Utilities::MPI::Partitioner> &base, Real *const *arrays,
              int count);
 
+    // The local indices that the exchange reads and writes, in the order of sum_packed: the
+    // owned entries other ranks hold as ghosts (each once, ascending), then the ghosts.
+    static std::vector<unsigned int> packed_indices(const dealii::Utilities::MPI::Partitioner &base);
+
+    // The same sums for an owner of the arrays that packs only those entries, entry by
+    // entry (the GPU engine: one copy each way): values[j * count + k] is array k at
+    // packed_indices(base)[j]. The ghosts' part is handed to MPI as it is, only the owned
+    // entries are copied (into the owned scratch and back); the results are those of sum()
+    // to the bit.
+    template <typename Real>
+    void sum_packed(const std::shared_ptr<const dealii::Utilities::MPI::Partitioner> &base, Real *values,
+                    int count);
+
   private:
+    // Follows a new base partitioner (a repartition: new numbering, new neighbours).
+    void set_base(const std::shared_ptr<const dealii::Utilities::MPI::Partitioner> &base);
+    // The Partitioner's import (ghosts added into their owners' entries) and export (the sums
+    // copied into the ghosts) on interleaved owned and ghost storage.
+    template <typename Real>
+    void import_and_export(const dealii::Utilities::MPI::Partitioner &p, Real *owned, Real *ghost, int count);
+
     // The interleaved partitioners of `base`, by count (built collectively on first use).
     const dealii::Utilities::MPI::Partitioner &interleaved(int count);
 
     std::shared_ptr<const dealii::Utilities::MPI::Partitioner>               base;
     std::map<int, std::unique_ptr<const dealii::Utilities::MPI::Partitioner>> by_count;
-    std::vector<unsigned int> import_local; // base's import indices, one per exchanged entry
+    std::vector<unsigned int> import_local;  // base's import indices, one per exchanged entry
+    std::vector<unsigned int> import_unique; // the same, each once, ascending
 
     // Interleaved scratch: owned entries (only the import positions are read or written),
     // ghosts, the Partitioner's import buffer. Owned scratch is not zero-filled.
