@@ -359,6 +359,10 @@ namespace mpm
       Staging<long>                exchanged_cells;
       ExchangeAdapter              exchange;
       DeviceArray<long>            home_cells; // several ranks: in upload order
+      // The same in the device's current point order (the per-step distance check reads them
+      // coalesced); gathered again after each change of order.
+      DeviceArray<long>            home_by_slot;
+      bool                         home_by_slot_stale = true;
       std::vector<DeviceArray<double>> labels; // several ranks: ids, initial positions; in upload order
       DeviceArray<std::uint8_t>    owned_cells; // several ranks: 1 for each lattice cell this rank owns
       // The re-sort's (take_leaving_points) flags, slot lists and gathers' scratch: kept
@@ -478,6 +482,7 @@ namespace mpm
       impl->points.upload(p);
       impl->order.reset(impl->backend, impl->points.size());
       impl->home_cells.resize(0); // set_home_cells gives those of these points
+      impl->home_by_slot_stale = true;
       impl->labels.clear();       // upload_labels gives those of these points
       impl->steps_since_upload = 0;
       impl->averaging_pending  = false; // the host's stresses are final
@@ -542,6 +547,7 @@ namespace mpm
             impl->order.template sort<QuadraticBSplineShape>(impl->backend, g, impl->points);
           else
             impl->order.template sort<LinearShape>(impl->backend, g, impl->points);
+          impl->home_by_slot_stale = true;
         }
       ++impl->steps_since_upload;
       if (s.pressure_averaging)
@@ -624,6 +630,7 @@ namespace mpm
       if (static_cast<int>(home_cells.size()) != impl->points.size())
         throw std::invalid_argument("DeviceEngine::set_home_cells: one home cell per uploaded point is needed");
       impl->home_cells.upload(home_cells);
+      impl->home_by_slot_stale = true;
     }
 
     template <int dim>
@@ -632,16 +639,26 @@ namespace mpm
       const int n = impl->points.size();
       if (static_cast<int>(impl->home_cells.size()) != n)
         throw std::logic_error("DeviceEngine: the home cells of the uploaded points are not known");
-      const PointsView<dim, double> p        = impl->points.view();
-      const GridView<dim, double>   g        = impl->grid.view();
-      const long                   *home     = impl->home_cells.data();
-      const int                    *original = impl->order.original_index(); // slot -> upload order
+      if (impl->home_by_slot_stale)
+        {
+          // Once per order (a stencil sort every sort_interval steps), not per step: the
+          // gather through the permutation is a random read per point.
+          impl->home_by_slot.resize(n);
+          const long *home     = impl->home_cells.data();
+          const int  *original = impl->order.original_index(); // slot -> upload order
+          long       *to       = impl->home_by_slot.data();
+          if (n > 0)
+            impl->backend.for_each_node(n, [=] MPM_HOST_DEVICE(const int i) { to[i] = home[original[i]]; });
+          impl->home_by_slot_stale = false;
+        }
+      const PointsView<dim, double> p    = impl->points.view();
+      const GridView<dim, double>   g    = impl->grid.view();
+      const long                   *home = impl->home_by_slot.data();
       return impl->backend.reduce_points(
         n, 0.0,
         [=] MPM_HOST_DEVICE(const int i) {
           return p.material[i] < 0 ? 0.0 :
-                                     distance_outside_home_cell<dim>(g.origin, g.h, g.n_cells, p.position,
-                                                                     home[original[i]], i);
+                                     distance_outside_home_cell<dim>(g.origin, g.h, g.n_cells, p.position, home[i], i);
         },
         [] MPM_HOST_DEVICE(const double a, const double b) { return a > b ? a : b; });
     }
@@ -793,6 +810,7 @@ namespace mpm
       impl->steps_since_upload = 0; // sorted by stencil at the next step
       impl->averaging_pending  = false;
       impl->home_cells.resize(n);
+      impl->home_by_slot_stale = true;
       const PointsView<dim, double> p    = impl->points.view();
       const GridView<dim, double>   g    = impl->grid.view();
       long                         *home = impl->home_cells.data();

@@ -28,11 +28,13 @@ namespace mpm
                                                          const int n_cells[dim], const Real *const position[dim],
                                                          const long home_cell, const int i)
   {
-    long c        = home_cell;
+    // In int: the lattice's cells are counted in int (GridView::lattice_cell), and a 64-bit
+    // division is several times the work of a 32-bit one on a GPU (this runs per point and step).
+    int  c        = static_cast<int>(home_cell);
     Real distance = Real(0);
     for (int d = 0; d < dim; ++d)
       {
-        const long lower = c % n_cells[d];
+        const int lower = c % n_cells[d];
         c /= n_cells[d];
         const Real s       = (position[d][i] - origin[d]) / h - Real(lower);
         const Real outside = s < Real(0) ? -s : (s > Real(1) ? s - Real(1) : Real(0));
