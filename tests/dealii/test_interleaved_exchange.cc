@@ -97,6 +97,30 @@ namespace
     p.export_to_ghosted_array_finish(ghost, requests);
   }
 
+  // count arrays over a partitioner's local storage, random in [-1, 1), seeded by rank.
+  template <typename Real>
+  std::vector<std::vector<Real>> random_arrays(const Utilities::MPI::Partitioner &partitioner, const int count,
+                                               const unsigned int seed)
+  {
+    const std::size_t n_local = partitioner.locally_owned_size() + partitioner.n_ghost_indices();
+    std::mt19937      random(seed + Utilities::MPI::this_mpi_process(partitioner.get_mpi_communicator()));
+    std::uniform_real_distribution<double> value(-1, 1);
+    std::vector<std::vector<Real>>         arrays(count, std::vector<Real>(n_local));
+    for (auto &array : arrays)
+      for (Real &v : array)
+        v = static_cast<Real>(value(random));
+    return arrays;
+  }
+
+  template <typename Real>
+  std::vector<Real *> pointers_to(std::vector<std::vector<Real>> &arrays)
+  {
+    std::vector<Real *> pointers;
+    for (auto &array : arrays)
+      pointers.push_back(array.data());
+    return pointers;
+  }
+
   template <typename Real>
   void check_bitwise(const std::shared_ptr<const Utilities::MPI::Partitioner> &partitioner,
                      mpm::InterleavedExchange &exchange, const int count, const char *what)
@@ -104,17 +128,8 @@ namespace
     const MPI_Comm     comm    = partitioner->get_mpi_communicator();
     const unsigned int rank    = Utilities::MPI::this_mpi_process(comm);
     const std::size_t  n_local = partitioner->locally_owned_size() + partitioner->n_ghost_indices();
-    std::mt19937       random(1234 + rank);
-    std::uniform_real_distribution<double> value(-1, 1);
-    std::vector<std::vector<Real>> arrays(count, std::vector<Real>(n_local)), alone;
-    std::vector<Real *>            pointers(count);
-    for (int k = 0; k < count; ++k)
-      {
-        for (Real &v : arrays[k])
-          v = static_cast<Real>(value(random));
-        pointers[k] = arrays[k].data();
-      }
-    alone = arrays;
+    std::vector<std::vector<Real>> arrays = random_arrays<Real>(*partitioner, count, 1234), alone = arrays;
+    std::vector<Real *>            pointers = pointers_to(arrays);
     exchange.sum(partitioner, pointers.data(), count);
     long differing = 0;
     for (int k = 0; k < count; ++k)
@@ -139,16 +154,8 @@ namespace
     const MPI_Comm     comm    = partitioner->get_mpi_communicator();
     const unsigned int rank    = Utilities::MPI::this_mpi_process(comm);
     const std::size_t  n_local = partitioner->locally_owned_size() + partitioner->n_ghost_indices();
-    std::mt19937       random(4321 + rank);
-    std::uniform_real_distribution<double> value(-1, 1);
-    std::vector<std::vector<Real>> arrays(count, std::vector<Real>(n_local));
-    std::vector<Real *>            pointers(count);
-    for (int k = 0; k < count; ++k)
-      {
-        for (Real &v : arrays[k])
-          v = static_cast<Real>(value(random));
-        pointers[k] = arrays[k].data();
-      }
+    std::vector<std::vector<Real>> arrays   = random_arrays<Real>(*partitioner, count, 4321);
+    std::vector<Real *>            pointers = pointers_to(arrays);
     const std::vector<unsigned int> packed_at = mpm::InterleavedExchange::packed_indices(*partitioner);
     std::vector<Real>               packed(packed_at.size() * count);
     for (std::size_t j = 0; j < packed_at.size(); ++j)
