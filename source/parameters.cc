@@ -197,6 +197,13 @@ namespace mpm
         prm.enter_subsection("Material " + name);
         prm.declare_entry("Model", "linear elastic", Patterns::Selection(material_model_names()),
                           "Constitutive model of this material, one of: " + material_model_names() + ".");
+        prm.declare_entry("Elastic law", "Jaumann rate", Patterns::Selection("Jaumann rate|Hencky"),
+                          "The elastic part of a built-in model at large strain. Jaumann rate: hypoelastic, the "
+                          "stress rotated with the spin plus C : d_eps per step. Hencky: hyperelastic in "
+                          "logarithmic strain (Kirchhoff stress = C : ln V_e), plasticity multiplicative with the "
+                          "model's return mapping in principal logarithmic strains (doc/theory-plasticity.md). The "
+                          "two agree at small strain. Hencky runs on the CPU backend only, and not with models "
+                          "defined outside the library.");
         for (const auto &[model, plugin] : material_library())
           {
             prm.enter_subsection(model);
@@ -493,6 +500,14 @@ namespace mpm
             fail("Material " + name + "/" + model, info.str());
           }
         prm.leave_subsection();
+        if (prm.get("Elastic law") == "Hencky")
+          {
+            if (materials.back().model == MaterialModel::user_defined)
+              fail("Material " + name + "/Elastic law", "Hencky needs a built-in model (linear elastic, drucker "
+                                                        "prager, mohr coulomb); '" + model + "' is defined outside "
+                                                        "the library and gets only strain and spin increments.");
+            materials.back().elastic_law = ElasticLaw::hencky;
+          }
         if (const UserConstitutiveModel *user = materials.back().user_model)
           {
             const std::vector<StateVariable> variables = user->state_variables();
@@ -728,10 +743,16 @@ namespace mpm
     prm.leave_subsection();
     if (backend == "cuda")
       for (unsigned int i = 0; i < materials.size(); ++i)
-        if (materials[i].model == MaterialModel::user_defined)
-          fail("Backend/Backend", "cuda cannot run material '" + material_names[i] + "': its model '" +
-                                    material_models[i] + "' is defined outside the library and runs on the "
-                                    "CPU backend only (Backend = cpu).");
+        {
+          if (materials[i].model == MaterialModel::user_defined)
+            fail("Backend/Backend", "cuda cannot run material '" + material_names[i] + "': its model '" +
+                                      material_models[i] + "' is defined outside the library and runs on the "
+                                      "CPU backend only (Backend = cpu).");
+          else if (materials[i].elastic_law == ElasticLaw::hencky)
+            fail("Backend/Backend", "cuda cannot run material '" + material_names[i] + "': its Elastic law = "
+                                      "Hencky runs on the CPU backend only for now (Backend = cpu, or Material " +
+                                      material_names[i] + "/Elastic law = Jaumann rate).");
+        }
 
     prm.enter_subsection("Resources");
     memory_limit = prm.get_double("Memory limit");

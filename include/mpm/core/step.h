@@ -608,6 +608,11 @@ namespace mpm
                 Ldt.a[a][b] = dt * L.a[a][b];
             const SymTensor<Real> d_eps = symmetric_part(Ldt);
 
+            StepKinematics<Real> kinematics;
+            kinematics.d_eps  = d_eps;
+            kinematics.d_spin = dW;
+            kinematics.f      = dF;
+            kinematics.J      = p.volume[i] / p.initial_volume[i]; // before the update below
             // F <- (I + L dt) F; the volume follows det F.
             if (!s.hold_points)
               {
@@ -621,6 +626,7 @@ namespace mpm
                     p.deformation_gradient[a * dim + b][i] = F.a[a][b];
                 p.volume[i] = p.initial_volume[i] * determinant(F);
               }
+            kinematics.J_new = p.volume[i] / p.initial_volume[i];
             MaterialPointState<Real> state;
             for (int c = 0; c < n_voigt; ++c)
               state.stress[c] = p.stress[c][i];
@@ -635,9 +641,9 @@ namespace mpm
 #endif
             const MaterialParameters<Real> &material = materials[p.material[i]];
             if (material.field_parameter == FieldParameter::none)
-              update_stress(material, d_eps, dW, state);
+              update_stress(material, kinematics, state);
             else
-              update_stress(with_field_value(material, p.material_field[i]), d_eps, dW, state);
+              update_stress(with_field_value(material, p.material_field[i]), kinematics, state);
             for (int c = 0; c < n_voigt; ++c)
               {
                 p.stress[c][i] = state.stress[c];

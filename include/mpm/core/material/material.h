@@ -6,6 +6,7 @@
 #pragma once
 
 #include <mpm/core/material/drucker_prager.h>
+#include <mpm/core/material/hencky.h>
 #include <mpm/core/material/linear_elastic.h>
 #include <mpm/core/material/mohr_coulomb.h>
 #include <mpm/core/material/user_model.h>
@@ -44,6 +45,9 @@ namespace mpm
     // at which plasticity is switched on); eps_p is then left unchanged.
     bool plasticity_enabled = true;
     FieldParameter field_parameter = FieldParameter::none;
+    // The elastic part's form (hencky.h); built-in models only. Hencky is compiled for the
+    // CPU backend only for now: the device's kernels keep the Jaumann rate.
+    ElasticLaw elastic_law = ElasticLaw::jaumann_rate;
     // model == user_defined: the model (host memory; owned by the material library).
     const UserConstitutiveModel *user_model = nullptr;
   };
@@ -86,6 +90,12 @@ namespace mpm
     return m;
   }
 
+  // The update of a point that knows its whole motion over the step (the MPM step): the
+  // material's elastic law picks the Jaumann rate form or Hencky's.
+  template <typename Real>
+  MPM_HOST_DEVICE inline void update_stress(const MaterialParameters<Real> &m, const StepKinematics<Real> &k,
+                                            MaterialPointState<Real> &state);
+
   template <typename Real>
   MPM_HOST_DEVICE inline void update_stress(const MaterialParameters<Real> &m,
                                             const SymTensor<Real>          &d_eps,
@@ -116,5 +126,40 @@ namespace mpm
           linear_elastic_update(m.elastic, d_eps, d_spin, state.stress);
           break;
       }
+  }
+
+  template <typename Real>
+  MPM_HOST_DEVICE inline void update_stress(const MaterialParameters<Real> &m, const StepKinematics<Real> &k,
+                                            MaterialPointState<Real> &state)
+  {
+#ifndef __CUDA_ARCH__
+    if (m.elastic_law == ElasticLaw::hencky && m.model != MaterialModel::user_defined)
+      {
+        switch (m.model)
+          {
+            case MaterialModel::drucker_prager:
+              hencky_update(m.elastic, m.plasticity_enabled, k, state.stress, state.plastic_strain,
+                            [&](SymTensor<Real> &tau, const Real eps_p) {
+                              return drucker_prager_return(m.elastic,
+                                                           drucker_prager_coefficients_at(m.drucker_prager, eps_p),
+                                                           tau);
+                            });
+              break;
+            case MaterialModel::mohr_coulomb:
+              hencky_update(m.elastic, m.plasticity_enabled, k, state.stress, state.plastic_strain,
+                            [&](SymTensor<Real> &tau, const Real eps_p) {
+                              return mohr_coulomb_return(m.elastic, current_strength(m.mohr_coulomb.strength, eps_p),
+                                                         tau);
+                            });
+              break;
+            default:
+              hencky_update(m.elastic, false, k, state.stress, state.plastic_strain,
+                            [](SymTensor<Real> &, const Real) { return elastic_return<Real>(); });
+              break;
+          }
+        return;
+      }
+#endif
+    update_stress(m, k.d_eps, k.d_spin, state);
   }
 } // namespace mpm
