@@ -20,17 +20,15 @@ import json
 import os
 import shutil
 import subprocess
-import platform
 import sys
-import time
 
 import numpy as np
 
 here = os.path.dirname(os.path.abspath(__file__))
-root = os.path.dirname(here)
 sys.path.insert(0, here)
 import column_error  # noqa: E402
 import mpm_results  # noqa: E402
+import mpm_runs  # noqa: E402
 
 # The methods: Solver entries set on top of the scene's own (its transfer, scheme and damping stay).
 METHODS = {
@@ -201,47 +199,20 @@ SCENES = {
 }
 
 
-def machine():
-    """Host name, CPU model and core count, for the doc's record of where a cell was measured."""
-    model = platform.processor() or "unknown CPU"
-    try:
-        with open("/proc/cpuinfo") as f:
-            model = next(line.split(":", 1)[1].strip() for line in f if line.startswith("model name"))
-    except (OSError, StopIteration):
-        pass
-    return f"{platform.node()}, {model}, {os.cpu_count()} cores"
-
-
-def write_scene(scene, method, label, out):
-    _, _, prm, runs, _ = SCENES[scene]
-    overrides, solver = runs[label]
-    os.makedirs(out)
-    copy = os.path.join(out, "scene.prm")
-    with open(os.path.join(root, prm)) as f:
-        text = f.read()
-    lines = ["", "subsection Output", f"  set Directory = {out}", "  set Progress interval = 0", "end"]
-    lines += overrides + ["subsection Solver"] + ["  " + s for s in solver + METHODS[method][1]] + ["end"]
-    with open(copy, "w") as f:
-        f.write(text + "\n".join(lines) + "\n")
-    return copy
-
-
 def run_cell(scene, method, exe, out):
-    runs, measure = SCENES[scene][3], SCENES[scene][4]
+    _, _, prm, runs, measure = SCENES[scene]
     shutil.rmtree(out, ignore_errors=True)
-    record = {"scene": scene, "method": method, "date": time.strftime("%Y-%m-%d"), "machine": machine()}
+    record = {"scene": scene, "method": method, "date": mpm_runs.today(), "machine": mpm_runs.machine()}
     outs = {}
-    for k, label in enumerate(runs):
+    for k, (label, (overrides, solver)) in enumerate(runs.items()):
         outs[label] = os.path.join(out, str(k)) if len(runs) > 1 else out
-        run = subprocess.run([exe, write_scene(scene, method, label, outs[label])], capture_output=True, text=True)
-        if run.returncode != 0:
-            message = [line for line in run.stderr.splitlines() + run.stdout.splitlines() if line.strip()]
-            unstable = next((line for line in message if "became unstable" in line), None)
-            where = f" ({label})" if len(runs) > 1 else ""
-            if unstable is not None and 0 < run.returncode < 128:
-                record.update(outcome="fails", reason=f"stopped{where}: " + unstable.strip())
-            else:
-                record.update(outcome="crash", reason=f"exit {run.returncode}{where}: " + " | ".join(message[-3:]))
+        done = mpm_runs.run(exe, prm, outs[label], overrides, solver + METHODS[method][1])
+        where = f" ({label})" if len(runs) > 1 else ""
+        if done["status"] == "unstable":
+            record.update(outcome="fails", reason=f"stopped{where}: " + done["message"])
+            return record
+        if done["status"] == "crash":
+            record.update(outcome="crash", reason=f"{done['message']}{where}")
             return record
     values, ok, text = measure(outs)
     record.update(values=values, outcome="stable" if ok else "fails", reason=text)
@@ -271,8 +242,7 @@ def matrix(records_dir):
         for m in methods:
             r = cells.get((scene, m))
             if r is not None:
-                reason = r["reason"].split(" To stabilise")[0]  # the program's advice is not a measure
-                lines.append(f"- {scene} / {METHODS[m][0]}: {r['outcome']}; {reason}")
+                lines.append(f"- {scene} / {METHODS[m][0]}: {r['outcome']}; {r['reason']}")
     return "\n".join(lines) + "\n"
 
 
