@@ -55,6 +55,8 @@ METHODS = {
     "gimp_pic": ("uGIMP, PIC", shape("GIMP") + ["set FLIP fraction = 0"], []),
     "gimp_flip": ("uGIMP, pure FLIP", shape("GIMP") + ["set FLIP fraction = 1"], []),
     "bspline2_pic": ("B-spline 2, PIC", shape("quadratic B-spline") + ["set FLIP fraction = 0"], []),
+    "gimp_apic": ("uGIMP, APIC", shape("GIMP") + ["set Velocity transfer = APIC"], []),
+    "bspline2_apic": ("B-spline 2, APIC", shape("quadratic B-spline") + ["set Velocity transfer = APIC"], []),
     "cpgimp_u_hencky": ("cpGIMP U, FLIP 0.99, Hencky", shape("GIMP", "U") + ["set FLIP fraction = 0.99"],
                         ["@material", "  set Elastic law = Hencky", "end"]),
 }
@@ -144,7 +146,7 @@ def draw(rows, figures):
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    markers = "osD^v<>ph*X"
+    markers = "osD^v<>ph*XPd"
     os.makedirs(figures, exist_ok=True)
     for scene in sorted({r["scene"] for r in rows}):
         mine = [r for r in rows if r["scene"] == scene and r["stable"] == "yes" and float(r["error"]) > 0]

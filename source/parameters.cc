@@ -167,7 +167,14 @@ namespace mpm
                       "1e-3 m/s; with Local damping form = force norm a threshold is needed, since a component "
                       "at rest up to round-off is otherwise braked by D |f| in a direction that round-off picks.");
     prm.declare_entry("FLIP fraction", "1", Patterns::Double(0, 1),
-                      "Velocity update: 1 = pure FLIP, 0 = pure PIC, in between a blend.");
+                      "Velocity update: 1 = pure FLIP, 0 = pure PIC, in between a blend. Not used with "
+                      "Velocity transfer = APIC.");
+    prm.declare_entry("Velocity transfer", "FLIP/PIC blend", Patterns::Selection("FLIP/PIC blend|APIC"),
+                      "FLIP/PIC blend: the points' velocities by FLIP fraction. APIC (Jiang et al. 2015): each point "
+                      "also carries an affine velocity matrix C (output as the fields apic_C_xx, apic_C_xy, ...), "
+                      "its momentum reaches the grid as m N (v + C (x_i - x_p)) and the grid gives back PIC's "
+                      "velocity and C; conserves angular momentum in the transfers without FLIP's noise. CPU "
+                      "backend only for now. C starts at zero.");
     prm.declare_entry("Gravity", zeros(dim, -9.81), point_pattern(dim),
                       "Gravitational acceleration vector (m/s^2).");
     prm.declare_entry("Gravity ramp time", "0", Patterns::Double(0),
@@ -469,6 +476,9 @@ namespace mpm
                                                                   : LocalDampingForm::per_component;
     damping_threshold = prm.get_double("Local damping threshold");
     flip_fraction     = prm.get_double("FLIP fraction");
+    apic              = prm.get("Velocity transfer") == "APIC";
+    if (apic)
+      flip_fraction = 0; // APIC's velocity is PIC's plus the affine part
     gravity           = get_point(prm, "Gravity", "Solver/");
     gravity_ramp_time = prm.get_double("Gravity ramp time");
     max_steps         = prm.get_integer("Maximum number of steps");
@@ -748,6 +758,9 @@ namespace mpm
             fail("Backend/Backend", "cuda cannot run material '" + material_names[i] + "': its model '" +
                                       material_models[i] + "' is defined outside the library and runs on the "
                                       "CPU backend only (Backend = cpu).");
+          else if (apic)
+            fail("Backend/Backend", "cuda cannot run Solver/Velocity transfer = APIC: it runs on the CPU backend "
+                                    "only for now (Backend = cpu, or Velocity transfer = FLIP/PIC blend).");
           else if (materials[i].elastic_law == ElasticLaw::hencky)
             fail("Backend/Backend", "cuda cannot run material '" + material_names[i] + "': its Elastic law = "
                                       "Hencky runs on the CPU backend only for now (Backend = cpu, or Material " +
@@ -773,7 +786,16 @@ namespace mpm
             else if (names[k] != variables[k].name)
               names[k] = "state_variable_" + std::to_string(k); // two models, two meanings
         }
+    if (apic) // APIC's affine matrix, after the models' own (affine_state_variable())
+      for (unsigned int a = 0; a < dim; ++a)
+        for (unsigned int b = 0; b < dim; ++b)
+          names.push_back(std::string("apic_C_") + "xyz"[a] + "xyz"[b]);
     return names;
+  }
+
+  int Parameters::affine_state_variable() const
+  {
+    return apic ? static_cast<int>(state_variable_names().size() - dim * dim) : -1;
   }
 
   std::vector<double> Parameters::initial_state_variables(const unsigned int material) const

@@ -177,6 +177,12 @@ namespace mpm
       {
         if (s.parallel)
           *given_bodies = gather_bodies(*given_bodies, s.communicator);
+        // APIC's affine matrices are the program's, not the caller's: points handed over
+        // without them start with C = 0.
+        if (parameters.affine_state_variable() >= 0)
+          for (GeneratedBody<dim> &body : *given_bodies)
+            if (body.points.size() > 0 && body.points.n_state_variables() == parameters.affine_state_variable())
+              body.points.set_n_state_variables(parameters.affine_state_variable() + dim * dim);
         check_state_variable_count(*given_bodies, parameters);
         *given_bodies = in_canonical_order(*given_bodies);
         check_given_points(*given_bodies, parameters);

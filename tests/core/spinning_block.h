@@ -25,12 +25,20 @@ namespace mpm_test
     long   n_steps      = 0;
   };
 
+  // The velocity transfer: the FLIP/PIC blend (flip_fraction), or APIC (affine matrix in the
+  // points' first dim x dim state variables, flip_fraction 0).
+  struct Transfer
+  {
+    double flip_fraction = 1;
+    bool   apic          = false;
+  };
+
   // Spins the block by `turn` radians at 2 rad/s; `points` receives the final state,
   // `initial` (if given) replaces the generated points; max_steps < 0: run the whole turn.
   template <int dim, typename Shape, template <int, typename> class Target = CpuTarget>
   SpinResult spinning_block(const mpm::DomainUpdate update, mpm::HostPoints<dim, double> &points,
                             const double turn = M_PI / 2, const long max_steps = -1,
-                            const mpm::HostPoints<dim, double> *initial = nullptr)
+                            const mpm::HostPoints<dim, double> *initial = nullptr, const Transfer transfer = {})
   {
     using namespace mpm;
     const double E = 1e6, nu = 0.3, rho = 1000, omega = 2, h = 0.125;
@@ -61,6 +69,12 @@ namespace mpm_test
       }
     if (initial != nullptr)
       points = *initial;
+    if (transfer.apic) // C = the spin's velocity gradient: [[0, -omega], [omega, 0]] in the xy plane
+      {
+        points.set_n_state_variables(dim * dim);
+        std::fill(points.state_variables[1].begin(), points.state_variables[1].end(), -omega);
+        std::fill(points.state_variables[dim].begin(), points.state_variables[dim].end(), omega);
+      }
     const std::vector<double> x0 = points.position[0], y0 = points.position[1];
     auto kinetic = [&]() {
       double k = 0;
@@ -88,7 +102,8 @@ namespace mpm_test
     for (int d = 0; d < dim; ++d)
       s.gravity[d] = 0;
     s.damping        = 0;
-    s.flip_fraction  = 1;
+    s.flip_fraction  = transfer.apic ? 0 : transfer.flip_fraction;
+    s.affine_state_variable = transfer.apic ? 0 : -1;
     s.domain_update  = update;
     s.mass_tolerance = 1e-12 * points.mass[0];
 

@@ -144,6 +144,31 @@ namespace mpm
               visit_position(s, node);
           }
     }
+
+    // The same nodes and weights with each node's offset from the point, x_i - x_p, as
+    // visit(node, N, grad, offset): APIC's affine transfers (step.h) need it.
+    template <typename Visitor>
+    void for_each_with_offset(const GridView<dim, Real> &grid, const Real x[dim], Visitor &&visit) const
+    {
+      constexpr int n_stencil = dim == 2 ? n * n : n * n * n;
+      for (int s = 0; s < n_stencil; ++s)
+        {
+          const int k[3] = {s % n, (s / n) % n, s / (n * n)};
+          int       idx[dim];
+          Real      offset[dim];
+          for (int d = 0; d < dim; ++d)
+            {
+              idx[d]    = first[d] + k[d];
+              offset[d] = grid.origin[d] + grid.h * idx[d] - x[d];
+            }
+          const int node = grid.node(idx);
+          if (node < 0)
+            continue;
+          Real       grad[dim];
+          const Real N = stencil_weight<dim, n>(w, dw, inv_h, k, grad);
+          visit(node, N, grad, offset);
+        }
+    }
   };
 #endif
 

@@ -58,6 +58,13 @@ namespace mpm
     // modes relax over thousands of steps (doc/log.md). The first held step, with this
     // set, starts from the points' momentum.
     bool hold_from_point_momentum = false;
+    // APIC (Jiang et al. 2015) instead of the FLIP/PIC blend: a point carries an affine
+    // velocity matrix C_p (dim x dim, row-major) in p.state_variables[affine_state_variable
+    // + a dim + b], its momentum reaches the grid as m N_i (v_p + C_p (x_i - x_p)), and G2P
+    // gives PIC's velocity and C_p (apic_affine_matrix). flip_fraction must be
+    // 0. -1: no APIC. Host backends whose stages use HostStencil only (the CPU's; explicit_step
+    // refuses the others).
+    int affine_state_variable = -1;
   };
 
   // Per-step reductions over the points: the next time step needs the largest speed,
@@ -216,6 +223,64 @@ namespace mpm
       return g.cell_pressure_volume[c] / g.cell_volume[c] - mean;
     }
 
+#if !defined(__CUDA_ARCH__) && !defined(MPM_UNROLL_STENCIL)
+    // APIC's affine matrix of a point from the nodal velocities v_i (`nodal`), in the gradient
+    // form C = sum_i v_i grad N_i^T (Jiang et al.'s B D^-1 for linear weights; for others D_p is
+    // computed from the stencil, and near the grid's faces, where nodes are missing, it becomes
+    // nearly singular: the V3 collapse blew up at 0.48 s with it, doc/log.md). Exact for affine
+    // fields v = A x + b wherever the weights reproduce linear fields: sum (A x_i + b) grad N_i^T
+    // = A sum x_i grad N_i^T = A.
+    template <int dim, typename Shape, typename Real>
+    inline void apic_affine_matrix(const GridView<dim, Real> &g, Real *const *nodal,
+                                   const HostStencil<dim, Shape, Real> &stencil, Real C[dim * dim])
+    {
+      for (int k = 0; k < dim * dim; ++k)
+        C[k] = Real(0);
+      stencil.for_each(g, [&](const int n, const Real, const Real *grad) {
+        for (int a = 0; a < dim; ++a)
+          for (int b = 0; b < dim; ++b)
+            C[a * dim + b] += nodal[a][n] * grad[b];
+      });
+    }
+
+    // The affine part of a point's momentum into its stencil: m N_i C (x_i - x_p).
+    template <typename Backend, int dim, typename Shape, typename Real>
+    inline void add_apic_momentum(const GridView<dim, Real> &g, const HostStencil<dim, Shape, Real> &stencil,
+                                  const Real x[dim], const Real m, const Real C[dim * dim])
+    {
+      Real *targets[dim];
+      for (int d = 0; d < dim; ++d)
+        targets[d] = g.momentum[d];
+      stencil.for_each_with_offset(g, x, [&](const int n, const Real N, const Real *, const Real *r) {
+        Real values[dim];
+        for (int a = 0; a < dim; ++a)
+          {
+            Real cr = Real(0);
+            for (int b = 0; b < dim; ++b)
+              cr += C[a * dim + b] * r[b];
+            values[a] = m * N * cr;
+          }
+        Backend::template add_to_node<dim>(targets, n, values);
+      });
+    }
+
+    template <int dim, typename Real>
+    inline void load_affine(const PointsView<dim, Real> &p, const StepSettings<dim, Real> &s, const int i,
+                            Real C[dim * dim])
+    {
+      for (int k = 0; k < dim * dim; ++k)
+        C[k] = p.state_variables[s.affine_state_variable + k][i];
+    }
+
+    template <int dim, typename Real>
+    inline void store_affine(const PointsView<dim, Real> &p, const StepSettings<dim, Real> &s, const int i,
+                             const Real C[dim * dim])
+    {
+      for (int k = 0; k < dim * dim; ++k)
+        p.state_variables[s.affine_state_variable + k][i] = C[k];
+    }
+#endif
+
     // P2G: nodal mass and momentum, and/or internal (-V sigma . grad N) and gravity forces.
     template <int dim, typename Shape, typename Real, typename Backend>
     void particles_to_grid(Backend                          &backend,
@@ -305,6 +370,14 @@ namespace mpm
               }
             scatter(force, targets + dim + 1);
           }
+#if !defined(__CUDA_ARCH__) && !defined(MPM_UNROLL_STENCIL)
+        if (mass_and_momentum && s.affine_state_variable >= 0)
+          {
+            Real C[dim * dim];
+            load_affine(p, s, i, C);
+            add_apic_momentum<Backend>(g, stencil, x, m, C);
+          }
+#endif
       });
     }
 
@@ -438,6 +511,14 @@ namespace mpm
           g, p, s, i, [&](auto &&visit) { for_each_stencil_node<dim, Shape>(g, x, lp, visit); }, v_new);
         for (int d = 0; d < dim; ++d)
           p.velocity[d][i] = v_new[d];
+#if !defined(__CUDA_ARCH__) && !defined(MPM_UNROLL_STENCIL)
+        if (s.affine_state_variable >= 0) // from v^{n+1}, which update_grid left in force[] (flip_fraction 0)
+          {
+            Real C[dim * dim];
+            apic_affine_matrix<dim>(g, g.force, HostStencil<dim, Shape, Real>(g, x, lp), C);
+            store_affine(p, s, i, C);
+          }
+#endif
       });
     }
 
@@ -490,6 +571,13 @@ namespace mpm
         Backend::template scatter_stencil<dim, Shape>(g, x, lp, targets, momentum);
 #else
         add_contribution<Backend>(stencil, targets, momentum);
+        if (s.affine_state_variable >= 0) // C from v^{n+1} (force[], flip_fraction 0), then its momentum
+          {
+            Real C[dim * dim];
+            apic_affine_matrix<dim>(g, g.force, *host_stencil, C);
+            store_affine(p, s, i, C);
+            add_apic_momentum<Backend>(g, *host_stencil, x, m, C);
+          }
 #endif
       });
     }
@@ -801,6 +889,20 @@ namespace mpm
                                     const Exchange &exchange = Exchange(), bool *averaging_pending = nullptr)
   {
     using namespace stages;
+    if (s.affine_state_variable >= 0)
+      {
+#if defined(MPM_UNROLL_STENCIL)
+        constexpr bool host_stencils = false;
+#else
+        constexpr bool host_stencils = !atomic_scatter<Backend>::value;
+#endif
+        if (!host_stencils)
+          throw std::invalid_argument("explicit_step: APIC runs on the CPU backend only");
+        if (s.flip_fraction != Real(0))
+          throw std::invalid_argument("explicit_step: APIC needs flip_fraction = 0 (its velocity is PIC's)");
+        if (p.n_state_variables < s.affine_state_variable + dim * dim)
+          throw std::invalid_argument("explicit_step: APIC's affine matrix needs dim x dim state variables");
+      }
     // The arrays summed over ranks after each P2G (MPI): after the first, mass, momentum
     // and force in one exchange (one round of messages, and on the GPU one staging).
     Real *mass_and_momentum[dim + 1], *momentum[dim], *forces[dim], *p2g_sums[2 * dim + 1];

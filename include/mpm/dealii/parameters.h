@@ -63,6 +63,7 @@ namespace mpm
     LocalDampingForm damping_form;
     double       damping_threshold; // m/s
     double       flip_fraction;
+    bool         apic; // Solver/Velocity transfer = APIC: C_p in the last dim x dim state variables
     std::vector<double> gravity;
     double       gravity_ramp_time;
     double       plasticity_start_time;
@@ -138,6 +139,9 @@ namespace mpm
     // (the model's own initial values, zero beyond its list).
     std::vector<std::string> state_variable_names() const;
     std::vector<double>      initial_state_variables(unsigned int material) const;
+    // Velocity transfer = APIC: the index of the first of the dim x dim state variables that hold
+    // each point's affine matrix (after the models' own); -1 otherwise.
+    int affine_state_variable() const;
 
     // Declares every entry for a given dimension, number of bodies and material names.
     static void declare(dealii::ParameterHandler &prm, unsigned int dim, unsigned int n_bodies,
