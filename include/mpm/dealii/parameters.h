@@ -63,7 +63,7 @@ namespace mpm
     LocalDampingForm damping_form;
     double       damping_threshold; // m/s
     double       flip_fraction;
-    bool         apic; // Solver/Velocity transfer = APIC: C_p in the last dim x dim state variables
+    bool         apic = false; // Solver/Velocity transfer = APIC: C_p in the last dim x dim state variables
     std::vector<double> gravity;
     double       gravity_ramp_time;
     double       plasticity_start_time;
