@@ -1,5 +1,6 @@
 """Read dealii-mpm output: the time series of particles (.pvd -> .pvtu -> .vtu pieces)
-and the time history (history.csv). Needs Debian's python3-numpy and python3-meshio."""
+and the time history (history.csv). Needs numpy; uses meshio where installed, else reads deal.II's
+.vtu pieces with numpy alone (the GPU hosts have no meshio)."""
 import csv
 import math
 import os
@@ -14,16 +15,59 @@ def pvd_records(output_dir, name="particles"):
     return [(float(d.get("timestep")), d.get("file")) for d in root.iter("DataSet")]
 
 
+VTK_TYPES = {"Float32": np.float32, "Float64": np.float64, "Int32": np.int32, "Int64": np.int64,
+             "UInt32": np.uint32, "UInt64": np.uint64, "UInt8": np.uint8, "Int8": np.int8}
+
+
+def _binary_array(element, compressed):
+    """The values of a DataArray in VTK's base64 "binary" format (deal.II's: UInt32 headers;
+    header and data encoded separately; zlib blocks where the file names vtkZLibDataCompressor)."""
+    import base64
+    import zlib
+    text = "".join(element.text.split())
+    dtype = VTK_TYPES[element.get("type")]
+    if not compressed:
+        size = np.frombuffer(base64.b64decode(text[:8]), np.uint32)[0]
+        raw = base64.b64decode(text[8:])[:size]
+    else:
+        n_blocks = int(np.frombuffer(base64.b64decode(text[:16]), np.uint32)[0])
+        header_chars = 4 * math.ceil(4 * (3 + n_blocks) / 3)
+        sizes = np.frombuffer(base64.b64decode(text[:header_chars]), np.uint32)[3:3 + n_blocks]
+        blob = base64.b64decode(text[header_chars:])
+        offsets = [0] + [int(s) for s in np.cumsum(sizes)]
+        raw = b"".join(zlib.decompress(blob[offsets[k]:offsets[k + 1]]) for k in range(n_blocks))
+    values = np.frombuffer(raw, dtype)
+    components = int(element.get("NumberOfComponents", "1"))
+    return values.reshape(-1, components) if components > 1 else values
+
+
+def read_vtu(path):
+    """(points, {name: point data}) of one .vtu piece as deal.II writes it, with numpy alone: the
+    fallback where meshio is not installed (the GPU hosts)."""
+    root = ET.parse(path).getroot()
+    compressed = root.get("compressor") is not None
+    points = _binary_array(root.find(".//Points/DataArray"), compressed)
+    data = {a.get("Name"): _binary_array(a, compressed) for a in root.findall(".//PointData/DataArray")}
+    return points, data
+
+
 def read_pvtu(output_dir, pvtu):
     """Points and point data of all pieces of one .pvtu file, merged."""
-    import meshio  # only here: the particle tables and histories need numpy alone
+    try:
+        import meshio  # only here: the particle tables and histories need numpy alone
+
+        def read(path):
+            m = meshio.read(path)
+            return m.points, m.point_data
+    except ImportError:
+        read = read_vtu
     root = ET.parse(os.path.join(output_dir, pvtu)).getroot()
     pieces = [p.get("Source") for p in root.iter("Piece")]
     points, data = [], {}
     for piece in pieces:
-        m = meshio.read(os.path.join(output_dir, piece))
-        points.append(m.points)
-        for key, value in m.point_data.items():
+        piece_points, piece_data = read(os.path.join(output_dir, piece))
+        points.append(piece_points)
+        for key, value in piece_data.items():
             data.setdefault(key, []).append(np.asarray(value, dtype=float))
     result = {key: np.concatenate(v) for key, v in data.items()}
     result["position"] = np.concatenate(points).astype(float)

@@ -488,6 +488,22 @@ namespace mpm
                      "host's part and MPI), of which the host's part "
                   << 1e3 * host_part / steps << " ms per step (copies into the partitioner's layout and MPI)\n";
       }
+    if (steps > 0)
+      {
+        // Per rank: where the loop's wall time went, ms per step (the rest of a step's wall
+        // time is the history, output and bookkeeping of advance()).
+        const auto             &l     = s.loop_times;
+        const double            per   = 1e3 / std::max(1L, l.steps);
+        const std::vector<double> mine = {per * l.engine, per * l.timer_sync, per * l.home_check,
+                                          per * l.reduction, 1e3 * l.resorts};
+        const auto all = s.parallel ? dealii::Utilities::MPI::gather(s.communicator, mine) :
+                                      std::vector<std::vector<double>>{mine};
+        for (std::size_t rank = 0; rank < all.size(); ++rank)
+          s.pcout << "  loop on rank " << rank << ", ms per step: engine step " << all[rank][0]
+                  << ", timer synchronisation " << all[rank][1] << ", home-cell check " << all[rank][2]
+                  << ", reduction over ranks " << all[rank][3] << "; re-sorts and repartitions "
+                  << all[rank][4] << " ms in all\n";
+      }
     s.pcout << "  output: " << s.output->n_outputs() << " outputs, " << s.output->task_seconds()
             << " s building and writing files on rank 0";
     if (parameters.output_in_background)

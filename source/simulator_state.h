@@ -292,9 +292,33 @@ namespace mpm
     // One step of the engine with the current settings, and what every step needs after it:
     // the largest speeds over the ranks, the MPI re-sort when points have strayed, the
     // stability check. Time and step counters are the caller's.
+    // Where a rank's wall time of the stepping loop goes, per part (seconds, summed over
+    // the steps): the engine's step, TimerOutput's synchronisation around it (a barrier and
+    // two reductions per step on several ranks, the wait for the slowest rank included),
+    // the check of how far points are from their home cells, the reduction over the ranks
+    // after the step, the re-sorts and repartitions. Printed per rank at the end.
+    struct LoopTimes
+    {
+      double engine = 0, timer_sync = 0, home_check = 0, reduction = 0, resorts = 0;
+      long   steps  = 0;
+    };
+    LoopTimes loop_times;
+
     void engine_step(const double dt)
     {
-      const StepReduction<double> r = nan_as_infinite(timed("MPM step", [&]() { return engine->step(settings, dt); }));
+      using clock            = std::chrono::steady_clock;
+      const auto   entered   = clock::now();
+      double       in_engine = 0;
+      const StepReduction<double> r = nan_as_infinite(timed("MPM step", [&]() {
+        const auto                  start = clock::now();
+        const StepReduction<double> step  = engine->step(settings, dt);
+        in_engine = std::chrono::duration<double>(clock::now() - start).count();
+        return step;
+      }));
+      const auto stepped = clock::now();
+      loop_times.engine += in_engine;
+      loop_times.timer_sync += std::chrono::duration<double>(stepped - entered).count() - in_engine;
+      ++loop_times.steps;
       gravity_power     = r.gravity_power;
       max_speed         = r.max_speed;
       max_removed_speed = r.max_removed_speed;
@@ -312,8 +336,12 @@ namespace mpm
           double local[4] = {r.max_speed, engine->max_distance_outside_home_cells(), r.max_removed_speed,
                              double(local_request())},
                  global[4];
+          const auto checked = clock::now();
           dealii::Utilities::MPI::max(dealii::ArrayView<const double>(local, 4), communicator,
                                       dealii::ArrayView<double>(global, 4));
+          const auto reduced = clock::now();
+          loop_times.home_check += std::chrono::duration<double>(checked - stepped).count();
+          loop_times.reduction += std::chrono::duration<double>(reduced - checked).count();
           max_speed         = global[0];
           max_removed_speed = global[2];
           request           = static_cast<int>(global[3]);
@@ -331,6 +359,7 @@ namespace mpm
               }
               if (balance())
                 engine->load(*points);
+              loop_times.resorts += std::chrono::duration<double>(clock::now() - reduced).count();
             }
         }
       // A blow-up shows as a non-finite velocity or, with the adaptive step, as speeds that
