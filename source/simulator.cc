@@ -471,7 +471,10 @@ namespace mpm
       {
         s.pcout << "  MPI: " << s.n_resorts << " re-sorts of the points into cells and ranks, "
                 << static_cast<long>(sum(double(s.points->n_sent), s.communicator)) << " points migrated, "
-                << s.n_repartitions << " repartitions; work per rank max/mean " << s.imbalance() << "\n";
+                << s.n_repartitions << " repartitions; work per rank max/mean " << s.imbalance() << "\n"
+                << "  MPI: the points' distances from their home cells checked in " << s.n_home_checks << " of "
+                << steps << " steps (in the others a bound from the largest speed showed no point could be "
+                << s.resort_at << " cells out)\n";
         // Ghost exchange per step: import + export of every ghost node's value, for each
         // array the scheme sums (MUSL: mass, momentum, force, then momentum again).
         const double ghosts = s.grid->partitioner->n_ghost_indices();

@@ -21,6 +21,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cstdlib>
 #include <cmath>
 #include <exception>
 #include <future>
@@ -176,6 +177,14 @@ namespace mpm
     bool                       initial_output_pending = false;
 
     double resort_at = 1e300;
+    // Several ranks: a bound on the distance of any point outside its home cell (cells), the
+    // sum of step_displacement_bound over the steps since the last re-sort; the points are
+    // checked only once it reaches resort_at (n_home_checks counts the checks).
+    double drift_bound = 0;
+    long   n_home_checks = 0;
+    // MPM_VERIFY_DRIFT_BOUND=1 (tests): check the points every step and stop where one is
+    // farther out than the bound says.
+    const bool verify_drift_bound = std::getenv("MPM_VERIFY_DRIFT_BOUND") != nullptr;
     long   n_resorts = 0, n_repartitions = 0;
     double balanced  = 1; // imbalance right after the last repartition: what p4est achieves
 
@@ -330,28 +339,41 @@ namespace mpm
       };
       if (parallel)
         {
-          // One reduction for the next time step and the migration test: the largest
-          // speed and the largest distance of a point outside its home cell.
-          // And what the ranks ask for after the step (a checkpoint, a stop).
-          double local[4] = {r.max_speed, engine->max_distance_outside_home_cells(), r.max_removed_speed,
-                             double(local_request())},
-                 global[4];
-          const auto checked = clock::now();
-          dealii::Utilities::MPI::max(dealii::ArrayView<const double>(local, 4), communicator,
-                                      dealii::ArrayView<double>(global, 4));
+          // One reduction for the next time step: the largest speeds, and what the ranks ask
+          // for after the step (a checkpoint, a stop).
+          double local[3] = {r.max_speed, r.max_removed_speed, double(local_request())}, global[3];
+          dealii::Utilities::MPI::max(dealii::ArrayView<const double>(local, 3), communicator,
+                                      dealii::ArrayView<double>(global, 3));
           const auto reduced = clock::now();
-          loop_times.home_check += std::chrono::duration<double>(checked - stepped).count();
-          loop_times.reduction += std::chrono::duration<double>(reduced - checked).count();
+          loop_times.reduction += std::chrono::duration<double>(reduced - stepped).count();
           max_speed         = global[0];
-          max_removed_speed = global[2];
-          request           = static_cast<int>(global[3]);
-          AssertThrow(!parameters.pressure_averaging || global[1] < 1,
+          max_removed_speed = global[1];
+          request           = static_cast<int>(global[2]);
+          // How far a point can be outside the cell it was sorted into: the sum of the
+          // steps' bounds since the last re-sort while that stays below the re-sort distance,
+          // the points' largest distance once it does (a pass over the points and a second
+          // reduction). The re-sorts come at the same steps either way.
+          drift_bound += step_displacement_bound(dt);
+          double distance = drift_bound;
+          if (!(drift_bound < resort_at) || verify_drift_bound)
+            {
+              distance = global_max(engine->max_distance_outside_home_cells());
+              ++n_home_checks;
+              AssertThrow(!verify_drift_bound || !(drift_bound < resort_at) || distance <= drift_bound,
+                          dealii::ExcMessage("Internal error (MPM_VERIFY_DRIFT_BOUND): a point is " +
+                                             dealii::Utilities::to_string(distance) +
+                                             " cells outside its home cell, beyond the bound " +
+                                             dealii::Utilities::to_string(drift_bound) + " " + when()));
+            }
+          const auto checked = clock::now();
+          loop_times.home_check += std::chrono::duration<double>(checked - reduced).count();
+          AssertThrow(!parameters.pressure_averaging || distance < 1,
                       dealii::ExcMessage("Parameter 'Solver/Pressure averaging': " + when() + " a point moved to " +
-                                         dealii::Utilities::to_string(global[1]) +
+                                         dealii::Utilities::to_string(distance) +
                                          " cells outside the cell it was sorted into, beyond the ghost cells "
                                          "whose pressure sums are exchanged between ranks. Reduce 'Solver/CFL "
                                          "number' or the time step."));
-          if (global[1] >= resort_at)
+          if (distance >= resort_at)
             {
               {
                 dealii::TimerOutput::Scope scope(timer, "migrate points");
@@ -359,7 +381,7 @@ namespace mpm
               }
               if (balance())
                 engine->load(*points);
-              loop_times.resorts += std::chrono::duration<double>(clock::now() - reduced).count();
+              loop_times.resorts += std::chrono::duration<double>(clock::now() - checked).count();
             }
         }
       // A blow-up shows as a non-finite velocity or, with the adaptive step, as speeds that
@@ -634,6 +656,22 @@ namespace mpm
       n_dropped += held.n_removed;
       dropped_mass += held.removed_mass;
       ++n_resorts;
+      drift_bound = 0; // every point is in its home cell now
+    }
+
+    // A bound on how far (in cells, max-norm) any point moved in the step of length dt just
+    // taken, from the largest speeds over the ranks; infinite where none is known. MUSL moves
+    // the points with the nodal velocities of its remap, m_i v_i = sum_p N_ip m_p v_p: a
+    // mass-weighted mean of the points' new velocities (those that left the grid in the step
+    // included), so no component exceeds the largest point speed; the shape functions'
+    // weights are non-negative and sum to at most 1, so a point moves at most dt times that.
+    // Wall contact and fixed components only shrink nodal velocities. APIC's remap adds
+    // C_p (x_i - x_p) and USL/USF move the points with v_i + dt a_i: no such bound.
+    double step_displacement_bound(const double dt) const
+    {
+      if (parameters.scheme != UpdateScheme::musl || settings.affine_state_variable >= 0)
+        return std::numeric_limits<double>::infinity();
+      return dt * std::max(max_speed, max_removed_speed) / h * (1 + 1e-9); // 1e-9: the sums' round-off
     }
 
     // Points are never made or lost but by leaving the grid: the points in the grid and those
