@@ -177,9 +177,10 @@ namespace mpm
     bool                       initial_output_pending = false;
 
     double resort_at = 1e300;
-    // Several ranks: a bound on the distance of any point outside its home cell (cells), the
-    // sum of step_displacement_bound over the steps since the last re-sort; the points are
-    // checked only once it reaches resort_at (n_home_checks counts the checks).
+    // Several ranks: a bound on the distance of any point outside its home cell (cells): the
+    // largest distance at the last check (0 after a re-sort) plus step_displacement_bound of
+    // every step since; the points are checked only once it reaches resort_at (n_home_checks
+    // counts those checks).
     double drift_bound = 0;
     long   n_home_checks = 0;
     // MPM_VERIFY_DRIFT_BOUND=1 (tests): check the points every step and stop where one is
@@ -349,21 +350,25 @@ namespace mpm
           max_speed         = global[0];
           max_removed_speed = global[1];
           request           = static_cast<int>(global[2]);
-          // How far a point can be outside the cell it was sorted into: the sum of the
-          // steps' bounds since the last re-sort while that stays below the re-sort distance,
-          // the points' largest distance once it does (a pass over the points and a second
-          // reduction). The re-sorts come at the same steps either way.
+          // How far a point can be outside the cell it was sorted into: the largest distance
+          // at the last check plus the steps' bounds since, while that stays below the
+          // re-sort distance (the distance is 1-Lipschitz in the position, max-norm); the
+          // points' largest distance (a pass over the points and a second reduction) once it
+          // does. The re-sorts come at the same steps either way.
           drift_bound += step_displacement_bound(dt);
-          double distance = drift_bound;
-          if (!(drift_bound < resort_at) || verify_drift_bound)
+          double     distance = drift_bound;
+          const bool needed   = !(drift_bound < resort_at);
+          if (needed || verify_drift_bound)
             {
               distance = global_max(engine->max_distance_outside_home_cells());
-              ++n_home_checks;
-              AssertThrow(!verify_drift_bound || !(drift_bound < resort_at) || distance <= drift_bound,
+              n_home_checks += needed;
+              AssertThrow(needed || distance <= drift_bound,
                           dealii::ExcMessage("Internal error (MPM_VERIFY_DRIFT_BOUND): a point is " +
                                              dealii::Utilities::to_string(distance) +
                                              " cells outside its home cell, beyond the bound " +
                                              dealii::Utilities::to_string(drift_bound) + " " + when()));
+              if (needed)
+                drift_bound = distance;
             }
           const auto checked = clock::now();
           loop_times.home_check += std::chrono::duration<double>(checked - reduced).count();
