@@ -39,7 +39,25 @@ METHODS = {
     "cpgimp_u": ("cpGIMP U", ["set Shape function = GIMP", "set GIMP domain update = U"]),
     "bspline2": ("quadratic B-spline", ["set Shape function = quadratic B-spline",
                                         "set GIMP domain update = none"]),
+    "ugimp_apic": ("uGIMP, APIC", ["set Shape function = GIMP", "set GIMP domain update = none",
+                                   "set Velocity transfer = APIC"]),
+    # Material entries: "@material" stands for each material of the scene's prm.
+    "cpgimp_u_hencky": ("cpGIMP U, Hencky", ["set Shape function = GIMP", "set GIMP domain update = U"],
+                        ["@material", "  set Elastic law = Hencky", "end"]),
 }
+
+
+def material_lines(prm, method):
+    """The method's material entries, once for every material the prm names."""
+    lines = METHODS[method][2] if len(METHODS[method]) > 2 else []
+    if not lines:
+        return []
+    with open(os.path.join(here, "..", prm)) as f:
+        names = next(line.split("=", 1)[1] for line in f if line.strip().startswith("set Names"))
+    result = []
+    for name in (n.strip() for n in names.split(",") if n.strip()):
+        result += [f"subsection Material {name}" if x == "@material" else x for x in lines]
+    return result
 
 
 def column(cells, extra_solver=(), extra=()):
@@ -206,7 +224,8 @@ def run_cell(scene, method, exe, out):
     outs = {}
     for k, (label, (overrides, solver)) in enumerate(runs.items()):
         outs[label] = os.path.join(out, str(k)) if len(runs) > 1 else out
-        done = mpm_runs.run(exe, prm, outs[label], overrides, solver + METHODS[method][1])
+        done = mpm_runs.run(exe, prm, outs[label], overrides + material_lines(prm, method),
+                            solver + METHODS[method][1])
         where = f" ({label})" if len(runs) > 1 else ""
         if done["status"] == "unstable":
             record.update(outcome="fails", reason=f"stopped{where}: " + done["message"])
