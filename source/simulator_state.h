@@ -180,8 +180,9 @@ namespace mpm
     // Several ranks: a bound on the distance of any point outside its home cell (cells): the
     // largest distance at the last check (0 after a re-sort) plus step_displacement_bound of
     // every step since; the points are checked only once it reaches resort_at (n_home_checks
-    // counts those checks).
-    double drift_bound = 0;
+    // counts those checks). Unknown until the first check: a resumed run's points may sit
+    // outside the cells they were saved in.
+    double drift_bound = std::numeric_limits<double>::infinity();
     long   n_home_checks = 0;
     // MPM_VERIFY_DRIFT_BOUND=1 (tests): check the points every step and stop where one is
     // farther out than the bound says.
