@@ -300,9 +300,6 @@ namespace mpm
       pcout << "  plasticity switched on at t = " << time << " s" << std::endl;
     }
 
-    // One step of the engine with the current settings, and what every step needs after it:
-    // the largest speeds over the ranks, the MPI re-sort when points have strayed, the
-    // stability check. Time and step counters are the caller's.
     // Where a rank's wall time of the stepping loop goes, per part (seconds, summed over
     // the steps): the engine's step, TimerOutput's synchronisation around it (a barrier and
     // two reductions per step on several ranks, the wait for the slowest rank included),
@@ -315,6 +312,9 @@ namespace mpm
     };
     LoopTimes loop_times;
 
+    // One step of the engine with the current settings, and what every step needs after it:
+    // the largest speeds over the ranks, the MPI re-sort when points have strayed, the
+    // stability check. Time and step counters are the caller's.
     void engine_step(const double dt)
     {
       using clock            = std::chrono::steady_clock;
