@@ -19,6 +19,9 @@
 //   --material elastic|dp   linear elastic stand-in, or ep2-3De's Drucker-Prager (default dp)
 //   --sort-every N          sort the points by stencil on the device every N steps (0: never;
 //                           default 20), so that the warp adders reduce runs of shared nodes
+//   --shape gimp|linear|bspline2|bspline3   the shape function (default gimp)
+//   --domain detF|Fii|U|none                GIMP's domain update (default detF, P1's own)
+//   --law jaumann|hencky                    the elastic law (default jaumann: the Jaumann rate)
 #include "p1_scene.h"
 
 #include <mpm/core/backend/cuda_backend.h>
@@ -53,6 +56,7 @@ namespace
     int              sort_every     = 20;
     ShapeFunction    shape          = ShapeFunction::gimp;
     DomainUpdate     domain         = DomainUpdate::det_F; // GIMP's; P1's own is det F
+    ElasticLaw       law            = ElasticLaw::jaumann_rate;
   };
 
   // Reorder every point array by perm (new point i is old point perm[i]).
@@ -182,6 +186,8 @@ namespace
     HostPoints<3, Real> points;
     std::vector<MaterialParameters<Real>> materials;
     mpm_bench::make_p1(n_cells_y, grid, points, materials, opt.drucker_prager);
+    for (auto &m : materials)
+      m.elastic_law = opt.law;
     reorder(points, grid, opt.order);
     const int  n_points = points.size();
     const long n_cells  = long(grid.n_cells[0]) * grid.n_cells[1] * grid.n_cells[2];
@@ -206,7 +212,9 @@ namespace
         {
           if (opt.shape == ShapeFunction::linear)
             order.template sort<LinearShape>(backend, gv, dpoints);
-          else // GIMP and the B-spline share the stencil's first node
+          else if (opt.shape == ShapeFunction::bspline3)
+            order.template sort<CubicBSplineShape>(backend, gv, dpoints);
+          else // GIMP and the quadratic B-spline share the stencil's first node
             order.template sort<GimpShape>(backend, gv, dpoints);
           pv = dpoints.view();
         }
@@ -283,7 +291,10 @@ namespace
     if (opt.block != 128)
       label += ", block " + std::to_string(opt.block);
     label += opt.drucker_prager ? ", DP" : ", elastic";
-    label += opt.shape == ShapeFunction::linear ? ", linear" : opt.shape == ShapeFunction::bspline2 ? ", B-spline" : "";
+    label += opt.law == ElasticLaw::hencky ? ", Hencky" : "";
+    label += opt.shape == ShapeFunction::linear   ? ", linear" :
+             opt.shape == ShapeFunction::bspline2 ? ", B-spline" :
+             opt.shape == ShapeFunction::bspline3 ? ", cubic B-spline" : "";
     if (opt.shape == ShapeFunction::gimp)
       label += opt.domain == DomainUpdate::U ? ", U domains" : opt.domain == DomainUpdate::stretch ? ", F_ii domains" :
                opt.domain == DomainUpdate::none ? ", uGIMP" : ", det F domains";
@@ -373,12 +384,14 @@ int main(int argc, char **argv)
       else if (a == "--shape" && i + 1 < argc)
         {
           const std::string m = argv[++i];
-          if (m != "gimp" && m != "linear" && m != "bspline2")
+          if (m != "gimp" && m != "linear" && m != "bspline2" && m != "bspline3")
             {
-              std::printf("--shape: expected gimp, linear or bspline2, got %s\n", m.c_str());
+              std::printf("--shape: expected gimp, linear, bspline2 or bspline3, got %s\n", m.c_str());
               return 2;
             }
-          opt.shape = m == "gimp" ? ShapeFunction::gimp : m == "linear" ? ShapeFunction::linear : ShapeFunction::bspline2;
+          opt.shape = m == "gimp"     ? ShapeFunction::gimp :
+                      m == "linear"   ? ShapeFunction::linear :
+                      m == "bspline2" ? ShapeFunction::bspline2 : ShapeFunction::bspline3;
         }
       else if (a == "--domain" && i + 1 < argc)
         {
@@ -390,6 +403,16 @@ int main(int argc, char **argv)
             }
           opt.domain = m == "detF" ? DomainUpdate::det_F : m == "Fii" ? DomainUpdate::stretch :
                        m == "U"    ? DomainUpdate::U : DomainUpdate::none;
+        }
+      else if (a == "--law" && i + 1 < argc)
+        {
+          const std::string m = argv[++i];
+          if (m != "jaumann" && m != "hencky")
+            {
+              std::printf("--law: expected jaumann or hencky, got %s\n", m.c_str());
+              return 2;
+            }
+          opt.law = m == "hencky" ? ElasticLaw::hencky : ElasticLaw::jaumann_rate;
         }
       else if (a == "--block" && i + 1 < argc)
         opt.block = std::atoi(argv[++i]);
@@ -411,7 +434,7 @@ int main(int argc, char **argv)
         {
           std::printf("usage: %s [--fp32] [--sizes 20,160,640,2560] [--steps N] [--profile] [--table FILE]\n"
                       "          [--order generated|cell|random] [--block N] [--material dp|elastic] [--sort-every N]\n"
-                      "          [--shape gimp|linear|bspline2] [--domain detF|Fii|U|none]\n",
+                      "          [--shape gimp|linear|bspline2|bspline3] [--domain detF|Fii|U|none] [--law jaumann|hencky]\n",
                       argv[0]);
           return 2;
         }

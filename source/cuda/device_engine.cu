@@ -545,6 +545,8 @@ namespace mpm
             impl->order.template sort<GimpShape>(impl->backend, g, impl->points);
           else if (impl->shape == ShapeFunction::bspline2)
             impl->order.template sort<QuadraticBSplineShape>(impl->backend, g, impl->points);
+          else if (impl->shape == ShapeFunction::bspline3)
+            impl->order.template sort<CubicBSplineShape>(impl->backend, g, impl->points);
           else
             impl->order.template sort<LinearShape>(impl->backend, g, impl->points);
           impl->home_by_slot_stale = true;

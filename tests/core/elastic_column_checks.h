@@ -42,34 +42,37 @@ namespace mpm_test
     check(last_smpm > 5 * errors.back(), "sMPM error exceeds 5x GIMP's", last_smpm, 5 * errors.back());
   }
 
-  // The quadratic B-spline on the column. With V1's compression of 78% its error stalls near
-  // 6e-3 (the points' quadrature of the B-splines degrades as they crowd: doc/methods.md),
-  // so it is asserted at small strain (E = 1 MPa, 0.78%), where it converges at second order.
-  // assert_targets: order >= 1.8 at each refinement, error < 1e-4 at the finest.
-  template <template <int, typename> class Target>
-  void check_bspline_column(const std::vector<int> &levels, const bool assert_targets)
+  // A B-spline (quadratic or cubic) on the column. With V1's compression of 78% the quadratic's
+  // error stalls near 6e-3 (the points' quadrature of the B-splines degrades as they crowd:
+  // doc/methods.md), so it is asserted at small strain (E = 1 MPa, 0.78%), where the B-splines
+  // converge at second order. assert_targets: order >= 1.8 at each refinement, error < 1e-4
+  // at the finest, below cpGIMP's at every level.
+  template <typename Shape, template <int, typename> class Target>
+  void check_bspline_column(const char *name, const std::vector<int> &levels, const bool assert_targets)
   {
     using namespace mpm;
-    std::printf("%8s %14s %14s %8s %14s\n", "cells", "B-spline 1MPa", "GIMP 1MPa", "order", "B-spline V1");
+    std::printf("%s\n%8s %14s %14s %8s %14s\n", name, "cells", "B-spline 1MPa", "GIMP 1MPa", "order", "B-spline V1");
     std::vector<double> errors;
+    const std::string   what = name;
     for (const int n : levels)
       {
         HostPoints<2, double> points;
         ColumnSetup           small{n, 0.5, DomainUpdate::none};
         small.youngs_modulus    = 1e6;
-        const ColumnResult b    = elastic_column<QuadraticBSplineShape, Target>(small, points);
+        const ColumnResult b    = elastic_column<Shape, Target>(small, points);
         small.domain_update     = DomainUpdate::stretch;
         const ColumnResult gimp = elastic_column<GimpShape, Target>(small, points);
-        const ColumnResult v1   = elastic_column<QuadraticBSplineShape, Target>({n, 0.5, DomainUpdate::none}, points);
+        const ColumnResult v1   = elastic_column<Shape, Target>({n, 0.5, DomainUpdate::none}, points);
         const double       order = errors.empty() ? 0 : std::log2(errors.back() / b.error);
         std::printf("%8d %14.4e %14.4e %8.2f %14.4e\n", n, b.error, gimp.error, order, v1.error);
         if (assert_targets && !errors.empty())
-          check(order >= 1.8, "B-spline, small strain: observed order >= 1.8", order, 1.8);
+          check(order >= 1.8, (what + ", small strain: observed order >= 1.8").c_str(), order, 1.8);
         if (assert_targets)
-          check(b.error < gimp.error, "B-spline, small strain: more accurate than cpGIMP", b.error, gimp.error);
+          check(b.error < gimp.error, (what + ", small strain: more accurate than cpGIMP").c_str(), b.error,
+                gimp.error);
         errors.push_back(b.error);
       }
     if (assert_targets)
-      check_below(errors.back(), 1e-4, "B-spline, small strain: finest-level error below 1e-4");
+      check_below(errors.back(), 1e-4, (what + ", small strain: finest-level error below 1e-4").c_str());
   }
 } // namespace mpm_test

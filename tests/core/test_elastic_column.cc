@@ -10,12 +10,18 @@ int main(int argc, char **argv)
   if (explore)
     {
       mpm_test::check_column_convergence<mpm_test::CpuTarget>({2, 4, 8, 16, 32, 64, 128, 256}, false);
-      mpm_test::check_bspline_column<mpm_test::CpuTarget>({2, 4, 8, 16, 32, 64, 128, 256}, false);
+      const std::vector<int> levels{2, 4, 8, 16, 32, 64, 128, 256};
+      mpm_test::check_bspline_column<mpm::QuadraticBSplineShape, mpm_test::CpuTarget>("quadratic B-spline", levels,
+                                                                                       false);
+      mpm_test::check_bspline_column<mpm::CubicBSplineShape, mpm_test::CpuTarget>("cubic B-spline", levels, false);
     }
   else
     {
       mpm_test::check_column_convergence<mpm_test::CpuTarget>({16, 32, 64}, true);
-      mpm_test::check_bspline_column<mpm_test::CpuTarget>({16, 32, 64}, true);
+      mpm_test::check_bspline_column<mpm::QuadraticBSplineShape, mpm_test::CpuTarget>("quadratic B-spline",
+                                                                                       {16, 32, 64}, true);
+      mpm_test::check_bspline_column<mpm::CubicBSplineShape, mpm_test::CpuTarget>("cubic B-spline", {16, 32, 64},
+                                                                                   true);
     }
   return mpm_test::finish("test_elastic_column");
 }

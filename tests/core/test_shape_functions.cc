@@ -1,7 +1,7 @@
 // Partition of unity, linear fields reproduced (weights and gradients), and gradients equal
-// to the derivative of the weights (finite differences), for the linear, GIMP and quadratic
-// B-spline stencils at random points, 2D and 3D. The B-spline is checked over the whole grid,
-// its folded boundary half-cells included (GIMP's domains inside the grid).
+// to the derivative of the weights (finite differences), for the linear, GIMP, quadratic and
+// cubic B-spline stencils at random points, 2D and 3D. The B-splines are checked over the
+// whole grid, their folded boundary cells included (GIMP's domains inside the grid).
 #include <mpm/core/host_storage.h>
 #include <mpm/core/interpolation.h>
 #include <mpm/core/shape_functions.h>
@@ -116,6 +116,8 @@ int main()
   check_family<3, GimpShape>("GIMP", rng);
   check_family<2, QuadraticBSplineShape>("quadratic B-spline", rng, true);
   check_family<3, QuadraticBSplineShape>("quadratic B-spline", rng, true);
+  check_family<2, CubicBSplineShape>("cubic B-spline", rng, true);
+  check_family<3, CubicBSplineShape>("cubic B-spline", rng, true);
 
   // GIMP tends to the linear hat as the particle domain shrinks.
   double w_lin[2], dw_lin[2], w_g[3], dw_g[3];
@@ -140,5 +142,33 @@ int main()
   stencil_weights_1d<QuadraticBSplineShape>(4.9, 0.0, 5, f_b, w_b, dw_b);
   mpm_test::check_below(std::abs(w_b[2]) + std::abs(w_b[1] - 0.9) + std::abs(w_b[0] - 0.1), 1e-15,
                         "B-spline folded at the upper face: the linear hats");
+
+  // The cubic B-spline in the interior: 2/3 - r^2 + |r|^3 / 2 within a cell of the node,
+  // (2 - |r|)^3 / 6 beyond; in the face's cell the ghost node's weight moves to the face
+  // node (x2) and its neighbour (x-1).
+  auto cubic = [](const double r) {
+    const double a = std::abs(r);
+    return a < 1 ? 2.0 / 3 - a * a + a * a * a / 2 : a < 2 ? (2 - a) * (2 - a) * (2 - a) / 6 : 0.0;
+  };
+  double w_c[4], dw_c[4];
+  int    f_c;
+  CubicBSplineShape::weights_1d(3.3, 0.0, f_c, w_c, dw_c);
+  mpm_test::check(f_c == 2, "cubic B-spline stencil starts one node below the point's cell", f_c, 2);
+  double cubic_error = 0;
+  for (int k = 0; k < 4; ++k)
+    cubic_error += std::abs(w_c[k] - cubic(3.3 - (2 + k)));
+  mpm_test::check_below(cubic_error, 1e-15, "cubic B-spline weights at s = 3.3");
+  stencil_weights_1d<CubicBSplineShape>(0.2, 0.0, 5, f_c, w_c, dw_c);
+  const double ghost = cubic(1.2);
+  mpm_test::check_below(std::abs(w_c[0]) + std::abs(w_c[1] - (cubic(0.2) + 2 * ghost)) +
+                          std::abs(w_c[2] - (cubic(0.8) - ghost)) + std::abs(w_c[3] - cubic(1.8)),
+                        1e-15, "cubic B-spline folded at the lower face");
+  stencil_weights_1d<CubicBSplineShape>(1.2, 0.0, 5, f_c, w_c, dw_c);
+  mpm_test::check_below(std::abs(w_c[0] - cubic(1.2)) + std::abs(w_c[1] - cubic(0.2)), 1e-15,
+                        "cubic B-spline not folded beyond the face's cell");
+  stencil_weights_1d<CubicBSplineShape>(4.7, 0.0, 5, f_c, w_c, dw_c);
+  mpm_test::check_below(std::abs(w_c[3]) + std::abs(w_c[2] - (cubic(0.3) + 2 * cubic(1.3))) +
+                          std::abs(w_c[1] - (cubic(0.7) - cubic(1.3))) + std::abs(w_c[0] - cubic(1.7)),
+                        1e-15, "cubic B-spline folded at the upper face");
   return mpm_test::finish("test_shape_functions");
 }

@@ -10,7 +10,10 @@ int main()
   try
     {
       mpm_test::check_column_convergence<mpm_test::CudaTarget>({16, 32, 64}, true);
-      mpm_test::check_bspline_column<mpm_test::CudaTarget>({16, 32, 64}, true);
+      mpm_test::check_bspline_column<mpm::QuadraticBSplineShape, mpm_test::CudaTarget>("quadratic B-spline",
+                                                                                        {16, 32, 64}, true);
+      mpm_test::check_bspline_column<mpm::CubicBSplineShape, mpm_test::CudaTarget>("cubic B-spline", {16, 32, 64},
+                                                                                    true);
     }
   catch (const std::exception &e)
     {

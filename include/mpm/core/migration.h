@@ -2,7 +2,7 @@
 // the deal.II layer last handed the points to the backend. In parallel runs the
 // owning rank has every node of a point's stencil only while the point is less than
 // a shape-dependent distance outside its home cell (half a cell for GIMP, one cell
-// for linear; doc/performance.md, MPI); the step loop re-sorts the points into cells
+// for linear, none for the cubic B-spline; doc/performance.md, MPI); the step loop re-sorts the points into cells
 // and ranks before any point gets that far.
 #pragma once
 
@@ -16,9 +16,10 @@ namespace mpm
   // nodes around them (the vertices of the home cell's neighbours).
   inline double safe_distance_outside_home_cell(const ShapeFunction shape)
   {
-    // GIMP and the B-spline: stencil first node floor(s + 1/2) - 1, three nodes; linear:
-    // floor(s), two.
-    return shape == ShapeFunction::linear ? 1.0 : 0.5;
+    // GIMP and the quadratic B-spline: stencil first node floor(s + 1/2) - 1, three nodes;
+    // linear: floor(s), two; the cubic B-spline: floor(s) - 1, four, so the point must stay
+    // in its home cell (the points are re-sorted as soon as one leaves it).
+    return shape == ShapeFunction::linear ? 1.0 : shape == ShapeFunction::bspline3 ? 0.0 : 0.5;
   }
 
   // Distance of point i outside its home cell (0 inside), in cell units, max-norm.

@@ -16,7 +16,8 @@ namespace mpm
   {
     linear = 0, // standard MPM: hat functions on the cell containing the point
     gimp   = 1, // generalised interpolation MP, particle domain of half-length lp
-    bspline2 = 2  // quadratic B-spline, its ghost node at a lattice face folded into the face's nodes
+    bspline2 = 2, // quadratic B-spline, its ghost node at a lattice face folded into the face's nodes
+    bspline3 = 3  // cubic B-spline, the same fold
   };
 
   // Standard MPM: the two nodes of the cell containing s.
@@ -124,34 +125,80 @@ namespace mpm
     }
   };
 
-  // Boundary treatment of the B-spline: the value at the ghost node one cell outside a face
+  // Cubic B-spline (C2, support 4h) centred on each node: the two nodes of the point's cell
+  // and one more on each side. Within one cell of a lattice face the stencil reaches a node
+  // outside the lattice; fold_boundary (below) removes it.
+  struct CubicBSplineShape
+  {
+    static constexpr int  n_per_direction = 4;
+    static constexpr bool folds_boundary  = true;
+
+    template <typename Real>
+    MPM_HOST_DEVICE static void
+    weights_1d(const Real s, const Real /*lp*/, int &first, Real w[4], Real dw[4])
+    {
+      first = static_cast<int>(std::floor(s)) - 1;
+      for (int k = 0; k < 4; ++k)
+        {
+          const Real r    = s - Real(first + k); // point minus node: d/dx_point = d/dr
+          const Real a    = r < Real(0) ? -r : r;
+          const Real sign = r < Real(0) ? Real(-1) : Real(1);
+          if (a < Real(1))
+            {
+              w[k]  = Real(2) / Real(3) - a * a + Real(0.5) * a * a * a;
+              dw[k] = sign * (Real(-2) * a + Real(1.5) * a * a);
+            }
+          else if (a < Real(2))
+            {
+              const Real b = Real(2) - a;
+              w[k]         = b * b * b / Real(6);
+              dw[k]        = -sign * Real(0.5) * b * b;
+            }
+          else
+            {
+              w[k]  = Real(0);
+              dw[k] = Real(0);
+            }
+        }
+    }
+  };
+
+  // Boundary treatment of the B-splines: the value at the ghost node one cell outside a face
   // is the linear extrapolation of the face node and its inner neighbour, u_ghost = 2 u_face
   // - u_inner, so the ghost's weight moves to them (x2 and x-1). Partition of unity and the
-  // reproduction of linear fields hold up to the face, all weights stay >= 0 (within half a
-  // cell of the face they become the linear hats 1 - r and r, meeting the B-splines C1 at
-  // r = 1/2), and no node outside the lattice is used. n_cells: the lattice's cells along the
-  // direction; first, w, dw from Shape::weights_1d.
+  // reproduction of linear fields hold up to the face, all weights stay >= 0, and no node
+  // outside the lattice is used. Quadratic: within half a cell of the face the weights become
+  // the linear hats 1 - r and r, meeting the B-splines C1 at r = 1/2. Cubic: the fold acts
+  // in the face's cell only, where the ghost's weight (1 - r)^3 / 6 fades out C2 at r = 1.
+  // n_cells: the lattice's cells along the direction; first, w, dw from Shape::weights_1d.
   template <typename Shape, typename Real>
   MPM_HOST_DEVICE inline void fold_boundary(const int n_cells, const int first, Real w[], Real dw[])
   {
     if constexpr (Shape::folds_boundary)
       {
-        static_assert(Shape::n_per_direction == 3, "the fold is written for three nodes per direction");
-        if (first == -1) // node -1 is the ghost below face 0
+        constexpr int n = Shape::n_per_direction;
+        // The stencil starts at most one node below the lattice (node -1) and ends at most
+        // one above (node n_cells + 1; the cubic's n_cells + 2 only for a point exactly on
+        // the face, with weight 0), two nodes away from the stencil's far end.
+        static_assert(n == 3 || n == 4, "the fold is written for three or four nodes per direction");
+        for (int k = 0; k < n; ++k)
           {
-            w[1] += Real(2) * w[0];
-            w[2] -= w[0];
-            dw[1] += Real(2) * dw[0];
-            dw[2] -= dw[0];
-            w[0] = dw[0] = Real(0);
-          }
-        if (first + 2 == n_cells + 1) // node n_cells + 1 is the ghost above face n_cells
-          {
-            w[1] += Real(2) * w[2];
-            w[0] -= w[2];
-            dw[1] += Real(2) * dw[2];
-            dw[0] -= dw[2];
-            w[2] = dw[2] = Real(0);
+            if (first + k == -1 && k + 2 < n) // the ghost below face 0
+              {
+                w[k + 1] += Real(2) * w[k];
+                w[k + 2] -= w[k];
+                dw[k + 1] += Real(2) * dw[k];
+                dw[k + 2] -= dw[k];
+                w[k] = dw[k] = Real(0);
+              }
+            if (first + k == n_cells + 1 && k >= 2) // the ghost above face n_cells
+              {
+                w[k - 1] += Real(2) * w[k];
+                w[k - 2] -= w[k];
+                dw[k - 1] += Real(2) * dw[k];
+                dw[k - 2] -= dw[k];
+                w[k] = dw[k] = Real(0);
+              }
           }
       }
     else

@@ -1015,6 +1015,8 @@ namespace mpm
       return explicit_step<dim, GimpShape>(backend, g, p, materials, s, dt, exchange, averaging_pending);
     if (shape == ShapeFunction::bspline2)
       return explicit_step<dim, QuadraticBSplineShape>(backend, g, p, materials, s, dt, exchange, averaging_pending);
+    if (shape == ShapeFunction::bspline3)
+      return explicit_step<dim, CubicBSplineShape>(backend, g, p, materials, s, dt, exchange, averaging_pending);
     return explicit_step<dim, LinearShape>(backend, g, p, materials, s, dt, exchange, averaging_pending);
   }
 } // namespace mpm

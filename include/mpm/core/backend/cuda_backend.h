@@ -282,8 +282,10 @@ namespace mpm
       constexpr int      n_c_even    = n_c + n_c % 2;
       constexpr int      stride      = at_c + n_c_even;
       constexpr unsigned all         = 0xffffffffu;
-      static_assert(stride <= cuda_detail::max_record_values, "stencil record too long for the staging area");
-      if (__activemask() != all || blockDim.x > cuda_detail::max_stencil_threads)
+      // A record longer than the staging area (the cubic B-spline's 4 x 4 x 4 nodes with
+      // gradients in 3D) adds point by point too.
+      constexpr bool     staged      = stride <= cuda_detail::max_record_values;
+      if (!staged || __activemask() != all || blockDim.x > cuda_detail::max_stencil_threads)
         {
           for_each_stencil_node<dim, Shape>(g, x, lp, [&](const int node, const Real N, const Real *grad) {
             Real values[K];

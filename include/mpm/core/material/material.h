@@ -132,7 +132,6 @@ namespace mpm
   MPM_HOST_DEVICE inline void update_stress(const MaterialParameters<Real> &m, const StepKinematics<Real> &k,
                                             MaterialPointState<Real> &state)
   {
-#ifndef __CUDA_ARCH__
     if (m.elastic_law == ElasticLaw::hencky && m.model != MaterialModel::user_defined)
       {
         switch (m.model)
@@ -159,7 +158,6 @@ namespace mpm
           }
         return;
       }
-#endif
     update_stress(m, k.d_eps, k.d_spin, state);
   }
 } // namespace mpm
