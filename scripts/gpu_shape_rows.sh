@@ -3,6 +3,7 @@
 # elastic law (12.8M points, 400 steps), and the default path (GIMP det F, Drucker-Prager,
 # Jaumann) timed against an older tree's build, interleaved. Everything goes to $OUT.
 #   scripts/gpu_shape_rows.sh [OLD_TREE]      OLD_TREE: a checkout of the earlier commit
+#   ROWS=0: only the default against the old tree, and Hencky's row. TESTS=0: the benchmark rows only; TESTS="test_gpu_cpu_agreement ...": those tests
 set -u -o pipefail
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
 OUT=${OUT:-$ROOT/output-gpu}
@@ -16,17 +17,19 @@ build() { # source build-dir targets...
     -DCMAKE_CUDA_ARCHITECTURES=90 >"$dir.log" 2>&1 && cmake --build "$dir" -j "$(nproc)" --target "$@" >>"$dir.log" 2>&1
 }
 T0=$(date +%s)
-build "$ROOT" /tmp/new p1_benchmark test_gpu_cpu_agreement test_gpu_elastic_column test_gpu_physics \
-  || { tail -30 /tmp/new.log; exit 1; } &
+TESTS=${TESTS:-test_gpu_elastic_column test_gpu_physics test_gpu_cpu_agreement}
+[ "$TESTS" = 0 ] && TESTS=""
+targets="p1_benchmark $TESTS"
+build "$ROOT" /tmp/new $targets || { tail -30 /tmp/new.log; exit 1; } &
 if [ -n "$OLD" ]; then build "$OLD" /tmp/old p1_benchmark || { tail -30 /tmp/old.log; exit 1; } & fi
 wait
 echo "builds: $(( $(date +%s) - T0 )) s"
-for t in test_gpu_elastic_column test_gpu_physics test_gpu_cpu_agreement; do
+for t in $TESTS; do
   timeout 300 /tmp/new/tests/gpu/$t >"$OUT/$t.log" 2>&1; echo "$t: exit $?"
   grep -E "GPU-CPU|FAILED|passed|cubic|quadratic|^ +(16|32|64) " "$OUT/$t.log" | head -40
 done
 P="--sizes 2560 --steps 400"
-row() { echo "== $*"; "$@" $P 2>&1 | grep -E "^\| " | tail -1; }
+row() { echo "== $* ($(date +%T))"; timeout 150 "$@" $P 2>&1 | grep -E "^\| " | tail -1; }
 {
   if [ -n "$OLD" ]; then
     for round in 1 2; do
@@ -34,10 +37,12 @@ row() { echo "== $*"; "$@" $P 2>&1 | grep -E "^\| " | tail -1; }
       row /tmp/new/benchmarks/p1_benchmark
     done
   fi
-  row /tmp/new/benchmarks/p1_benchmark --shape linear
-  row /tmp/new/benchmarks/p1_benchmark --domain none
-  row /tmp/new/benchmarks/p1_benchmark --shape bspline2
-  row /tmp/new/benchmarks/p1_benchmark --shape bspline3
+  if [ "${ROWS:-1}" = 1 ]; then
+    row /tmp/new/benchmarks/p1_benchmark --shape linear
+    row /tmp/new/benchmarks/p1_benchmark --domain none
+    row /tmp/new/benchmarks/p1_benchmark --shape bspline2
+    row /tmp/new/benchmarks/p1_benchmark --shape bspline3
+    row /tmp/new/benchmarks/p1_benchmark --domain U
+  fi
   row /tmp/new/benchmarks/p1_benchmark --domain U --law hencky
-  row /tmp/new/benchmarks/p1_benchmark --domain U
 } 2>&1 | tee "$OUT/p1_rows.log"
