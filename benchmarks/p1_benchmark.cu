@@ -21,7 +21,6 @@
 //                           default 20), so that the warp adders reduce runs of shared nodes
 //   --shape gimp|linear|bspline2|bspline3   the shape function (default gimp)
 //   --domain detF|Fii|U|none                GIMP's domain update (default detF, P1's own)
-//   --law jaumann|hencky                    the elastic law (default jaumann: the Jaumann rate)
 #include "p1_scene.h"
 
 #include <mpm/core/backend/cuda_backend.h>
@@ -56,7 +55,6 @@ namespace
     int              sort_every     = 20;
     ShapeFunction    shape          = ShapeFunction::gimp;
     DomainUpdate     domain         = DomainUpdate::det_F; // GIMP's; P1's own is det F
-    ElasticLaw       law            = ElasticLaw::jaumann_rate;
   };
 
   // Reorder every point array by perm (new point i is old point perm[i]).
@@ -186,8 +184,6 @@ namespace
     HostPoints<3, Real> points;
     std::vector<MaterialParameters<Real>> materials;
     mpm_bench::make_p1(n_cells_y, grid, points, materials, opt.drucker_prager);
-    for (auto &m : materials)
-      m.elastic_law = opt.law;
     reorder(points, grid, opt.order);
     const int  n_points = points.size();
     const long n_cells  = long(grid.n_cells[0]) * grid.n_cells[1] * grid.n_cells[2];
@@ -291,7 +287,6 @@ namespace
     if (opt.block != 128)
       label += ", block " + std::to_string(opt.block);
     label += opt.drucker_prager ? ", DP" : ", elastic";
-    label += opt.law == ElasticLaw::hencky ? ", Hencky" : "";
     label += opt.shape == ShapeFunction::linear   ? ", linear" :
              opt.shape == ShapeFunction::bspline2 ? ", B-spline" :
              opt.shape == ShapeFunction::bspline3 ? ", cubic B-spline" : "";
@@ -404,16 +399,6 @@ int main(int argc, char **argv)
           opt.domain = m == "detF" ? DomainUpdate::det_F : m == "Fii" ? DomainUpdate::stretch :
                        m == "U"    ? DomainUpdate::U : DomainUpdate::none;
         }
-      else if (a == "--law" && i + 1 < argc)
-        {
-          const std::string m = argv[++i];
-          if (m != "jaumann" && m != "hencky")
-            {
-              std::printf("--law: expected jaumann or hencky, got %s\n", m.c_str());
-              return 2;
-            }
-          opt.law = m == "hencky" ? ElasticLaw::hencky : ElasticLaw::jaumann_rate;
-        }
       else if (a == "--block" && i + 1 < argc)
         opt.block = std::atoi(argv[++i]);
       else if (a == "--table" && i + 1 < argc)
@@ -434,7 +419,7 @@ int main(int argc, char **argv)
         {
           std::printf("usage: %s [--fp32] [--sizes 20,160,640,2560] [--steps N] [--profile] [--table FILE]\n"
                       "          [--order generated|cell|random] [--block N] [--material dp|elastic] [--sort-every N]\n"
-                      "          [--shape gimp|linear|bspline2|bspline3] [--domain detF|Fii|U|none] [--law jaumann|hencky]\n",
+                      "          [--shape gimp|linear|bspline2|bspline3] [--domain detF|Fii|U|none]\n",
                       argv[0]);
           return 2;
         }

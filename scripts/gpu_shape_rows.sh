@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
-# On the GPU machine: the core's GPU tests and the P1 benchmark's rows per shape function and
-# elastic law (12.8M points, 400 steps), and the default path (GIMP det F, Drucker-Prager,
+# On the GPU machine: the core's GPU tests and the P1 benchmark's rows per shape function
+# (12.8M points, 400 steps), and the default path (GIMP det F, Drucker-Prager,
 # Jaumann) timed against an older tree's build, interleaved. Everything goes to $OUT.
 #   scripts/gpu_shape_rows.sh [OLD_TREE]      OLD_TREE: a checkout of the earlier commit
-#   ROWS=0: only the default against the old tree, and Hencky's row. TESTS=0: the benchmark rows only; TESTS="test_gpu_cpu_agreement ...": those tests
+#   ROWS=0: only the default against the old tree. TESTS=0: no tests; TESTS="a b": those tests
 set -u -o pipefail
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
 OUT=${OUT:-$ROOT/output-gpu}
@@ -44,5 +44,4 @@ row() { echo "== $* ($(date +%T))"; timeout 150 "$@" $P 2>&1 | grep -E "^\| " | 
     row /tmp/new/benchmarks/p1_benchmark --shape bspline3
     row /tmp/new/benchmarks/p1_benchmark --domain U
   fi
-  row /tmp/new/benchmarks/p1_benchmark --domain U --law hencky
 } 2>&1 | tee "$OUT/p1_rows.log"

@@ -765,6 +765,10 @@ namespace mpm
           else if (apic)
             fail("Backend/Backend", "cuda cannot run Solver/Velocity transfer = APIC: it runs on the CPU backend "
                                     "only for now (Backend = cpu, or Velocity transfer = FLIP/PIC blend).");
+          else if (materials[i].elastic_law == ElasticLaw::hencky)
+            fail("Backend/Backend", "cuda cannot run material '" + material_names[i] + "': its Elastic law = "
+                                      "Hencky runs on the CPU backend only for now (Backend = cpu, or Material " +
+                                      material_names[i] + "/Elastic law = Jaumann rate).");
         }
 
     prm.enter_subsection("Resources");

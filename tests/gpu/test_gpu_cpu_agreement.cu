@@ -169,10 +169,6 @@ int main()
       // polar decomposition: closed form in 2D, eigen-decomposition in 3D), undamped
       spin_agreement<2>();
       spin_agreement<3>();
-      // Hencky's finite-strain elasticity (two eigen decompositions per point and step): the
-      // column compressed by up to 78% (cpGIMP U) and the block spun in 3D
-      column_agreement<GimpShape>("2D GIMP U, Hencky", DomainUpdate::U, ElasticLaw::hencky);
-      spin_agreement<3>(ElasticLaw::hencky);
       // The cubic B-spline: its fold at the column's base and sides, and in 3D its 64-node
       // stencil, which the device scatters point by point (too long for the staging area)
       column_agreement<CubicBSplineShape>("2D cubic B-spline", DomainUpdate::none);

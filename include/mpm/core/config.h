@@ -8,14 +8,6 @@
 #  define MPM_HOST_DEVICE
 #endif
 
-// A function the device calls out of line (the host may inline it): for rarely taken
-// branches whose code would raise the register count of the kernel around them.
-#if defined(__CUDACC__)
-#  define MPM_DEVICE_NOINLINE __noinline__
-#else
-#  define MPM_DEVICE_NOINLINE
-#endif
-
 namespace mpm
 {
   // Stress and strain are stored as 6 Voigt-ordered components in 2D as well:

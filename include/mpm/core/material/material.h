@@ -128,44 +128,38 @@ namespace mpm
       }
   }
 
-  // Hencky's update of a library model. Out of line on the device: inlined, its two eigen
-  // decompositions raised the register count of the kernel that moves and deforms the points
-  // for every run, and P1 (Jaumann) stepped 4% slower on an H100 (doc/methods.md).
-  template <typename Real>
-  MPM_HOST_DEVICE MPM_DEVICE_NOINLINE void hencky_stress_update(const MaterialParameters<Real> &m,
-                                                                const StepKinematics<Real> &k,
-                                                                MaterialPointState<Real>   &state)
-  {
-    switch (m.model)
-      {
-        case MaterialModel::drucker_prager:
-          hencky_update(m.elastic, m.plasticity_enabled, k, state.stress, state.plastic_strain,
-                        [&](SymTensor<Real> &tau, const Real eps_p) {
-                          return drucker_prager_return(m.elastic,
-                                                       drucker_prager_coefficients_at(m.drucker_prager, eps_p), tau);
-                        });
-          break;
-        case MaterialModel::mohr_coulomb:
-          hencky_update(m.elastic, m.plasticity_enabled, k, state.stress, state.plastic_strain,
-                        [&](SymTensor<Real> &tau, const Real eps_p) {
-                          return mohr_coulomb_return(m.elastic, current_strength(m.mohr_coulomb.strength, eps_p),
-                                                     tau);
-                        });
-          break;
-        default:
-          hencky_update(m.elastic, false, k, state.stress, state.plastic_strain,
-                        [](SymTensor<Real> &, const Real) { return elastic_return<Real>(); });
-          break;
-      }
-  }
-
   template <typename Real>
   MPM_HOST_DEVICE inline void update_stress(const MaterialParameters<Real> &m, const StepKinematics<Real> &k,
                                             MaterialPointState<Real> &state)
   {
+#ifndef __CUDA_ARCH__
     if (m.elastic_law == ElasticLaw::hencky && m.model != MaterialModel::user_defined)
-      hencky_stress_update(m, k, state);
-    else
-      update_stress(m, k.d_eps, k.d_spin, state);
+      {
+        switch (m.model)
+          {
+            case MaterialModel::drucker_prager:
+              hencky_update(m.elastic, m.plasticity_enabled, k, state.stress, state.plastic_strain,
+                            [&](SymTensor<Real> &tau, const Real eps_p) {
+                              return drucker_prager_return(m.elastic,
+                                                           drucker_prager_coefficients_at(m.drucker_prager, eps_p),
+                                                           tau);
+                            });
+              break;
+            case MaterialModel::mohr_coulomb:
+              hencky_update(m.elastic, m.plasticity_enabled, k, state.stress, state.plastic_strain,
+                            [&](SymTensor<Real> &tau, const Real eps_p) {
+                              return mohr_coulomb_return(m.elastic, current_strength(m.mohr_coulomb.strength, eps_p),
+                                                         tau);
+                            });
+              break;
+            default:
+              hencky_update(m.elastic, false, k, state.stress, state.plastic_strain,
+                            [](SymTensor<Real> &, const Real) { return elastic_return<Real>(); });
+              break;
+          }
+        return;
+      }
+#endif
+    update_stress(m, k.d_eps, k.d_spin, state);
   }
 } // namespace mpm
