@@ -64,27 +64,18 @@ def weights(kind, s, lp, N):
         w, dw = Bc(r), dBc(r)
     elif kind == "bcd":
         w = (Mc(r+lpc) - Mc(r-lpc))/(2*lpc); dw = (Bc(r+lpc) - Bc(r-lpc))/(2*lpc)
-    # fold ghosts: node -1 -> 2*u0 - u1 ; node -2 -> 3 u0 - 2 u1 ; top: N+1 -> 2uN - u(N-1), N+2 -> 3uN - 2u(N-1)
-    if kind != "gimp" and kind != "linear":
-        for g, a0, a1 in ((-1, 2, -1), (-2, 3, -2)):
+    # Ghosts folded by linear extrapolation: u_ghost = a0 u_face + a1 u_inner.
+    if kind not in ("gimp", "linear"):
+        for g, face, inner, a0, a1 in ((-1, 0, 1, 2, -1), (-2, 0, 1, 3, -2), (N + 1, N, N - 1, 2, -1),
+                                       (N + 2, N, N - 1, 3, -2)):
             m = idx == g
             if m.any():
                 rows = np.nonzero(m.any(1))[0]
                 col = np.argmax(m[rows], 1)
                 for arr in (w, dw):
                     val = arr[rows, col].copy()
-                    arr[rows, col+1*(0-g)] += a0*val  # node 0 at col - g
-                    arr[rows, col+1*(1-g)] += a1*val
-                    arr[rows, col] = 0
-        for g, a0, a1 in ((N+1, 2, -1), (N+2, 3, -2)):
-            m = idx == g
-            if m.any():
-                rows = np.nonzero(m.any(1))[0]
-                col = np.argmax(m[rows], 1)
-                for arr in (w, dw):
-                    val = arr[rows, col].copy()
-                    arr[rows, col-(g-N)] += a0*val
-                    arr[rows, col-(g-N)-1] += a1*val
+                    arr[rows, col + (face - g)] += a0 * val
+                    arr[rows, col + (inner - g)] += a1 * val
                     arr[rows, col] = 0
     w = np.where((idx < 0) | (idx > N), 0.0, w); dw = np.where((idx < 0) | (idx > N), 0.0, dw)
     return np.clip(idx, 0, N), w, dw
