@@ -24,7 +24,6 @@ namespace mpm_test
     double            damping       = 0.05;
     long              max_steps     = -1; // < 0: run to 2 t_ramp
     double            youngs_modulus = 1e4; // V1's; 1e6 compresses by 0.78%, not 78%
-    mpm::ElasticLaw   elastic_law    = mpm::ElasticLaw::jaumann_rate;
   };
 
   struct ColumnResult
@@ -69,7 +68,6 @@ namespace mpm_test
     material.model                  = MaterialModel::linear_elastic;
     material.elastic.youngs_modulus = E;
     material.elastic.poissons_ratio = 0;
-    material.elastic_law            = setup.elastic_law;
 
     StepSettings<2, double> s;
     s.scheme         = UpdateScheme::musl;

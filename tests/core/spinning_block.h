@@ -34,13 +34,11 @@ namespace mpm_test
   };
 
   // Spins the block by `turn` radians at 2 rad/s; `points` receives the final state,
-  // `initial` (if given) replaces the generated points; max_steps < 0: run the whole turn;
-  // `law` the block's elastic law.
+  // `initial` (if given) replaces the generated points; max_steps < 0: run the whole turn.
   template <int dim, typename Shape, template <int, typename> class Target = CpuTarget>
   SpinResult spinning_block(const mpm::DomainUpdate update, mpm::HostPoints<dim, double> &points,
                             const double turn = M_PI / 2, const long max_steps = -1,
-                            const mpm::HostPoints<dim, double> *initial = nullptr, const Transfer transfer = {},
-                            const mpm::ElasticLaw law = mpm::ElasticLaw::jaumann_rate)
+                            const mpm::HostPoints<dim, double> *initial = nullptr, const Transfer transfer = {})
   {
     using namespace mpm;
     const double E = 1e6, nu = 0.3, rho = 1000, omega = 2, h = 0.125;
@@ -98,7 +96,6 @@ namespace mpm_test
     material.model                  = MaterialModel::linear_elastic;
     material.elastic.youngs_modulus = E;
     material.elastic.poissons_ratio = nu;
-    material.elastic_law            = law;
 
     StepSettings<dim, double> s;
     s.scheme = UpdateScheme::musl;

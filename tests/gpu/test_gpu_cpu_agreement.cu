@@ -91,14 +91,13 @@ void report(const char *scene, const Difference &gpu, const Difference &reordere
   check(gpu.removed_mismatch == 0, (std::string(scene) + ": same points removed").c_str());
 }
 
-// The V1 column with the given shape (and elastic law), CPU against the GPU, unsorted and sorted.
+// The V1 column with the given shape, CPU against the GPU, unsorted and sorted.
 template <typename Shape>
-void column_agreement(const char *shape, const DomainUpdate update, const ElasticLaw law = ElasticLaw::jaumann_rate)
+void column_agreement(const char *shape, const DomainUpdate update)
 {
   const long            n = 1000;
   HostPoints<2, double> cpu, gpu, initial;
   ColumnSetup           setup{32, 0.5, update};
-  setup.elastic_law = law;
   setup.max_steps = 0;
   elastic_column<Shape, CpuTarget>(setup, initial);
   setup.max_steps = n;
@@ -114,33 +113,32 @@ void column_agreement(const char *shape, const DomainUpdate update, const Elasti
             spread, n, true);
 }
 
-// The spinning block on the given target: cpGIMP with the U domain update and the given
-// elastic law, or the cubic B-spline (Jaumann).
+// The spinning block on the given target: cpGIMP with the U domain update, or the cubic
+// B-spline.
 template <int dim, template <int, typename> class Target>
-void spin(const ElasticLaw law, const bool cubic, HostPoints<dim, double> &out, const HostPoints<dim, double> *start,
-          const long steps)
+void spin(const bool cubic, HostPoints<dim, double> &out, const HostPoints<dim, double> *start, const long steps)
 {
   if (cubic)
     spinning_block<dim, CubicBSplineShape, Target>(DomainUpdate::none, out, M_PI / 2, steps, start);
   else
-    spinning_block<dim, GimpShape, Target>(DomainUpdate::U, out, M_PI / 2, steps, start, {}, law);
+    spinning_block<dim, GimpShape, Target>(DomainUpdate::U, out, M_PI / 2, steps, start);
 }
 
 // The spinning block, 300 steps (a third of the quarter turn).
 template <int dim>
-void spin_agreement(const ElasticLaw law = ElasticLaw::jaumann_rate, const bool cubic = false)
+void spin_agreement(const bool cubic = false)
 {
   const long              n = 300;
   HostPoints<dim, double> cpu, gpu, initial;
-  spin<dim, CpuTarget>(law, cubic, initial, nullptr, 0);
-  spin<dim, CpuTarget>(law, cubic, cpu, &initial, n);
+  spin<dim, CpuTarget>(cubic, initial, nullptr, 0);
+  spin<dim, CpuTarget>(cubic, cpu, &initial, n);
   const Difference spread = cpu_reordering_spread(
-    initial, cpu, 0.125, [&](auto &out, const auto *start) { spin<dim, CpuTarget>(law, cubic, out, start, n); });
-  const std::string scene = std::string("spinning block ") + (cubic ? "cubic B-spline" : "U") +
-                            (law == ElasticLaw::hencky ? ", Hencky" : "") + (dim == 2 ? " (2D)" : " (3D)");
-  spin<dim, CudaTarget>(law, cubic, gpu, &initial, n);
+    initial, cpu, 0.125, [&](auto &out, const auto *start) { spin<dim, CpuTarget>(cubic, out, start, n); });
+  const std::string scene =
+    std::string("spinning block ") + (cubic ? "cubic B-spline" : "U") + (dim == 2 ? " (2D)" : " (3D)");
+  spin<dim, CudaTarget>(cubic, gpu, &initial, n);
   report<dim>(scene.c_str(), compare_points(cpu, gpu, 0.125), spread, n, false);
-  spin<dim, CudaSortedTarget>(law, cubic, gpu, &initial, n);
+  spin<dim, CudaSortedTarget>(cubic, gpu, &initial, n);
   report<dim>((scene + ", GPU sorted every 7").c_str(), compare_points(cpu, gpu, 0.125), spread, n, false);
 }
 
@@ -172,7 +170,7 @@ int main()
       // The cubic B-spline: its fold at the column's base and sides, and in 3D its 64-node
       // stencil, which the device scatters point by point (too long for the staging area)
       column_agreement<CubicBSplineShape>("2D cubic B-spline", DomainUpdate::none);
-      spin_agreement<3>(ElasticLaw::jaumann_rate, true);
+      spin_agreement<3>(true);
       {
         // V3 geometry, elastic, the equilibration's steps (points held, the grid keeping its
         // velocities, damping 0.8) from zero stress. The damped path follows round-off (the
