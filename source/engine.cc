@@ -1,3 +1,4 @@
+#include <mpm/core/active_nodes.h>
 #include <mpm/core/backend/cpu_backend.h>
 #include <mpm/core/migration.h>
 #include <mpm/dealii/cuda_engine.h>
@@ -13,14 +14,31 @@ namespace mpm
     class CpuEngine : public Engine<dim>
     {
     public:
-      // One rank: the engine's own nodes on the lattice, no exchange.
+      // One rank: the engine's own nodes on the lattice, no exchange. With active_block_cells
+      // > 0 only those near the material (active_nodes.h), chosen when points are loaded and
+      // by refresh_active_nodes(); the lattice's boundary masks are kept to fill them.
       CpuEngine(const HostGrid<dim, double> &lattice, const std::vector<MaterialParameters<double>> &materials,
-                const ShapeFunction shape)
-        : own_nodes(lattice)
+                const ShapeFunction shape, const int active_block_cells)
+        : active_block_cells(active_block_cells)
         , materials(materials)
         , shape(shape)
       {
-        own_nodes.allocate_cells();
+        if (active_block_cells == 0)
+          {
+            own_nodes = lattice;
+            own_nodes.allocate_cells();
+            return;
+          }
+        own_nodes.h = lattice.h;
+        for (int d = 0; d < dim; ++d)
+          {
+            own_nodes.origin[d]  = lattice.origin[d];
+            own_nodes.n_cells[d] = lattice.n_cells[d];
+          }
+        for (int f = 0; f < 2 * dim; ++f)
+          own_nodes.friction_coefficient[f] = lattice.friction_coefficient[f];
+        lattice_fixed_components = lattice.fixed_components;
+        lattice_friction_faces   = lattice.friction_faces;
       }
 
       // Several ranks: the grid's vectors are the nodal arrays, summed over ranks.
@@ -47,15 +65,54 @@ namespace mpm
         // New points: the scatter's slabs are built anew for them, as in a new engine (a
         // run resumed from a checkpoint then sums in the order of the run that wrote it).
         backend.forget_grouping();
+        if (follows_material())
+          refresh_active_nodes();
       }
 
       void load(const HostPoints<dim, double> &p, std::shared_ptr<const PointLabels<dim>> new_labels) override
       {
         points = p;
-        home_cells.clear(); // asked for on several ranks only, which load from the handler
+        home_cells.clear(); // asked for on several ranks (loaded from the handler) and below
         labels = std::move(new_labels);
         backend.forget_grouping();
+        if (follows_material())
+          refresh_active_nodes();
       }
+
+      bool follows_material() const override { return active_block_cells > 0; }
+
+      double active_node_margin() const override
+      {
+        return follows_material() ? mpm::active_node_margin(shape, active_block_cells) : 0;
+      }
+
+      // The nodes near the points as they are now; their nodal sums start from zero, as
+      // every step's do. Every point's home cell becomes its current cell.
+      void refresh_active_nodes() override
+      {
+        if (!follows_material())
+          return;
+        ActiveNodes active = nodes_near_points<dim>(own_nodes.origin, own_nodes.h, own_nodes.n_cells,
+                                                    active_block_cells, points.view(), &home_cells);
+        own_nodes.lattice_to_node = std::move(active.lattice_to_node);
+        lattice_of_node           = std::move(active.lattice_of_node);
+        const long n              = static_cast<long>(lattice_of_node.size());
+        own_nodes.allocate_nodes(static_cast<int>(n));
+        own_nodes.friction_faces.assign(lattice_friction_faces.empty() ? 0 : n, 0);
+        for (long node = 0; node < n; ++node)
+          {
+            own_nodes.fixed_components[node] = lattice_fixed_components[lattice_of_node[node]];
+            if (!lattice_friction_faces.empty())
+              own_nodes.friction_faces[node] = lattice_friction_faces[lattice_of_node[node]];
+          }
+        own_nodes.cell_volume.assign(n, 0.0); // the cells' sums at their lowest vertex
+        own_nodes.cell_pressure_volume.assign(n, 0.0);
+        most_active_nodes = std::max(most_active_nodes, n);
+      }
+
+      long n_active_nodes() const override { return static_cast<long>(own_nodes.mass.size()); }
+
+      long most_nodes() const override { return most_active_nodes; }
 
       unsigned int store(MaterialPoints<dim> &p) override
       {
@@ -77,9 +134,15 @@ namespace mpm
           return;
         const GridView<dim, double> to = grid.view();
         const long                  n  = static_cast<long>(own_nodes.mass.size());
+        if (follows_material()) // the others are zero (no mass, no velocity)
+          {
+            std::fill(to.mass, to.mass + to.n_nodes, 0.0);
+            for (int d = 0; d < dim; ++d)
+              std::fill(to.velocity[d], to.velocity[d] + to.n_nodes, 0.0);
+          }
         for (long l = 0; l < n; ++l)
           {
-            const int node = to.lattice_to_node[l];
+            const int node = to.lattice_to_node[follows_material() ? lattice_of_node[l] : l];
             to.mass[node]  = own_nodes.mass[l];
             for (int d = 0; d < dim; ++d)
               to.velocity[d][node] = own_nodes.velocity[d][l];
@@ -109,7 +172,10 @@ namespace mpm
         if (shared_grid == nullptr)
           {
             GridView<dim, double> g = make_grid_view<dim, double>(own_nodes);
-            g.lattice_to_node       = nullptr; // lattice order: a node's index is its lattice index
+            if (follows_material())
+              g.cell_sums_at_nodes = true;
+            else
+              g.lattice_to_node = nullptr; // lattice order: a node's index is its lattice index
             return explicit_step<dim>(backend, shape, g, points.view(), materials.data(), s, dt, NoGridExchange());
           }
         GridView<dim, double> g = shared_grid->view();
@@ -129,6 +195,12 @@ namespace mpm
       // the cell sums; the nodes are shared_grid's vectors.
       HostGrid<dim, double>                   own_nodes;
       BackgroundGrid<dim>                    *shared_grid = nullptr;
+      // Nodes near the material only (one rank): the block size in cells (0: every node),
+      // the lattice index of each active node, the whole lattice's boundary masks.
+      int                       active_block_cells = 0;
+      std::vector<long>         lattice_of_node;
+      std::vector<std::uint8_t> lattice_fixed_components, lattice_friction_faces;
+      long                      most_active_nodes = 0;
       std::vector<MaterialParameters<double>> materials;
       ShapeFunction                           shape;
       CpuBackend                              backend;
@@ -149,12 +221,17 @@ namespace mpm
   template <int dim>
   std::unique_ptr<Engine<dim>> make_engine(const std::string &backend, const HostGrid<dim, double> &lattice,
                                            const std::vector<MaterialParameters<double>> &materials,
-                                           const ShapeFunction shape)
+                                           const ShapeFunction shape, const int active_block_cells)
   {
     check_backend(backend);
     if (backend == "cuda")
-      return make_cuda_engine<dim>(lattice, materials, shape); // throws where no device is found
-    return std::make_unique<CpuEngine<dim>>(lattice, materials, shape);
+      {
+        AssertThrow(active_block_cells == 0,
+                    dealii::ExcMessage("Parameter 'Grid/Nodes': 'near material' runs on the cpu backend only so "
+                                       "far (allowed with Backend = cuda: all)."));
+        return make_cuda_engine<dim>(lattice, materials, shape); // throws where no device is found
+      }
+    return std::make_unique<CpuEngine<dim>>(lattice, materials, shape, active_block_cells);
   }
 
   template <int dim>
@@ -169,9 +246,9 @@ namespace mpm
   }
 
   template std::unique_ptr<Engine<2>> make_engine(const std::string &, const HostGrid<2, double> &,
-                                                  const std::vector<MaterialParameters<double>> &, ShapeFunction);
+                                                  const std::vector<MaterialParameters<double>> &, ShapeFunction, int);
   template std::unique_ptr<Engine<3>> make_engine(const std::string &, const HostGrid<3, double> &,
-                                                  const std::vector<MaterialParameters<double>> &, ShapeFunction);
+                                                  const std::vector<MaterialParameters<double>> &, ShapeFunction, int);
   template std::unique_ptr<Engine<2>> make_engine(const std::string &, BackgroundGrid<2> &,
                                                   const std::vector<MaterialParameters<double>> &, ShapeFunction);
   template std::unique_ptr<Engine<3>> make_engine(const std::string &, BackgroundGrid<3> &,

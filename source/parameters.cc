@@ -111,6 +111,16 @@ namespace mpm
                       "Upper corner of the background grid (m). Each extent must be a multiple of the cell size.");
     prm.declare_entry("Cell size", "0.1", Patterns::Double(0),
                       "Edge length h of the square/cubic grid cells (m), the same in every direction.");
+    prm.declare_entry("Nodes", "all", Patterns::Selection("all|near material"),
+                      "Which nodes of the grid the step keeps and updates. all: every node of the box. near "
+                      "material: only those of the blocks of Active block size^dim cells that hold a material "
+                      "point or touch such a block, chosen again whenever a point has moved far enough to need "
+                      "others; cost and memory of the step then follow the material, not the box (the results "
+                      "are the same bit for bit). One rank and Backend = cpu only for now; on several ranks each "
+                      "rank keeps every node of its part of the grid.");
+    prm.declare_entry("Active block size", "4", Patterns::Integer(1, 64),
+                      "Nodes = near material: edge of the blocks, in cells. Every cell within this many cells "
+                      "of a point's cell is kept; larger blocks choose the nodes less often but keep more.");
     prm.leave_subsection();
 
     prm.enter_subsection("Boundary conditions");
@@ -431,6 +441,7 @@ namespace mpm
                                    dealii::Utilities::to_string(upper[d] - lower[d]) +
                                    " m) is not a whole number of cells of size " + prm.get("Cell size") + ".");
       }
+    active_block_cells = prm.get("Nodes") == "near material" ? prm.get_integer("Active block size") : 0;
     prm.leave_subsection();
 
     prm.enter_subsection("Boundary conditions");
@@ -755,6 +766,8 @@ namespace mpm
     backend       = prm.get("Backend");
     sort_interval = prm.get_integer("Sort interval");
     prm.leave_subsection();
+    if (backend == "cuda" && active_block_cells > 0)
+      fail("Grid/Nodes", "near material runs on the cpu backend only for now (Backend = cpu, or Nodes = all).");
     if (backend == "cuda")
       for (unsigned int i = 0; i < materials.size(); ++i)
         {

@@ -288,7 +288,7 @@ namespace mpm
         if (cuda_ready.valid())
           cuda_ready.get();
         s.engine = make_engine<dim>(parameters.backend, lattice_grid<dim>(parameters), s.materials,
-                                    parameters.shape_function);
+                                    parameters.shape_function, parameters.active_block_cells);
         s.engine->set_sort_interval(parameters.sort_interval);
         s.engine->load(host, std::move(labels));
         s.engine_setup_seconds =
@@ -306,13 +306,6 @@ namespace mpm
         s.timer.leave_subsection();
       }
 
-    // MPI: points re-sorted into cells and ranks, grid repartitioned by work.
-    // Pressure averaging in parallel: a point's cell at the end of a step must be an owned
-    // or ghost cell of its rank (whose cell sums the exchange covers), i.e. less than one
-    // cell outside its home cell. Re-sorting at half a cell (GIMP's safe distance already)
-    // leaves a step's displacement of room; the check after each step asserts it.
-    s.resort_at = std::min(parameters.resort_distance * safe_distance_outside_home_cell(parameters.shape_function),
-                           s.parallel && parameters.pressure_averaging ? 0.5 : 1e300);
     if (s.parallel)
       {
         s.timer.enter_subsection("setup: engine");
@@ -324,6 +317,7 @@ namespace mpm
         s.engine->load(*s.points);
         s.timer.leave_subsection();
       }
+    s.set_resort_distance();
 
     s.print_header();
     s.apply_settings();
@@ -467,6 +461,11 @@ namespace mpm
             << "  loss checks: " << s.n_points_initial - s.n_removed << " points in the grid + " << s.n_removed
             << " removed = " << s.n_points_initial << " initial; mass in the grid + removed = initial mass to "
             << s.worst_mass_balance << " (largest relative difference over the history rows)\n";
+    if (s.engine->follows_material())
+      s.pcout << "  nodes near the material: " << s.engine->n_active_nodes() << " at the end, "
+              << s.engine->most_nodes() << " at most; chosen again " << s.n_node_refreshes
+              << " times; the points' distances from the cells they were in checked in " << s.n_home_checks
+              << " of " << steps << " steps\n";
     if (s.parallel)
       {
         s.pcout << "  MPI: " << s.n_resorts << " re-sorts of the points into cells and ranks, "

@@ -114,12 +114,11 @@ namespace mpm
       }
     s.timer.leave_subsection();
 
-    s.resort_at = std::min(parameters.resort_distance * safe_distance_outside_home_cell(parameters.shape_function),
-                           s.parallel && parameters.pressure_averaging ? 0.5 : 1e300);
     s.timer.enter_subsection("setup: engine");
     if (cuda_ready.valid())
       cuda_ready.get();
     s.start_from(saved);
+    s.set_resort_distance();
     s.timer.leave_subsection();
 
     s.print_header();

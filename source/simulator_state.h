@@ -188,6 +188,7 @@ namespace mpm
     // farther out than the bound says.
     const bool verify_drift_bound = std::getenv("MPM_VERIFY_DRIFT_BOUND") != nullptr;
     long   n_resorts = 0, n_repartitions = 0;
+    long   n_node_refreshes = 0; // one rank, nodes near the material: how often they were chosen again
     double balanced  = 1; // imbalance right after the last repartition: what p4est achieves
 
     double time = 0, max_speed = 0, max_removed_speed = 0, work_of_gravity = 0, dt = 0, gravity_power = 0;
@@ -351,26 +352,7 @@ namespace mpm
           max_speed         = global[0];
           max_removed_speed = global[1];
           request           = static_cast<int>(global[2]);
-          // How far a point can be outside the cell it was sorted into: the largest distance
-          // at the last check plus the steps' bounds since, while that stays below the
-          // re-sort distance (the distance is 1-Lipschitz in the position, max-norm); the
-          // points' largest distance (a pass over the points and a second reduction) once it
-          // does. The re-sorts come at the same steps either way.
-          drift_bound += step_displacement_bound(dt);
-          double     distance = drift_bound;
-          const bool needed   = !(drift_bound < resort_at);
-          if (needed || verify_drift_bound)
-            {
-              distance = global_max(engine->max_distance_outside_home_cells());
-              n_home_checks += needed;
-              AssertThrow(needed || distance <= drift_bound,
-                          dealii::ExcMessage("Internal error (MPM_VERIFY_DRIFT_BOUND): a point is " +
-                                             dealii::Utilities::to_string(distance) +
-                                             " cells outside its home cell, beyond the bound " +
-                                             dealii::Utilities::to_string(drift_bound) + " " + when()));
-              if (needed)
-                drift_bound = distance;
-            }
+          const double distance = distance_outside_home_cells(dt, when);
           const auto checked = clock::now();
           loop_times.home_check += std::chrono::duration<double>(checked - reduced).count();
           AssertThrow(!parameters.pressure_averaging || distance < 1,
@@ -387,6 +369,20 @@ namespace mpm
               }
               if (balance())
                 engine->load(*points);
+              loop_times.resorts += std::chrono::duration<double>(clock::now() - checked).count();
+            }
+        }
+      else if (engine->follows_material())
+        {
+          // The nodes near the material chosen again before a point's stencil can leave them.
+          const double distance = distance_outside_home_cells(dt, when);
+          const auto   checked  = clock::now();
+          loop_times.home_check += std::chrono::duration<double>(checked - stepped).count();
+          if (distance >= resort_at)
+            {
+              engine->refresh_active_nodes();
+              ++n_node_refreshes;
+              drift_bound = 0; // every point is in its home cell now
               loop_times.resorts += std::chrono::duration<double>(clock::now() - checked).count();
             }
         }
@@ -547,6 +543,14 @@ namespace mpm
             << " material points, " << n_ranks << " MPI rank(s), backend " << parameters.backend << "\n"
             << "  elastic wave speed " << c_el << " m/s, end time " << parameters.end_time << " s, output in '"
             << output->directory() << "'" << std::endl;
+      if (engine->follows_material())
+        pcout << "  nodes near the material: " << engine->n_active_nodes() << " of the " << n_nodes
+              << " (blocks of " << parameters.active_block_cells << " cells), chosen again once a point is "
+              << resort_at << " cells out of the cell it was in" << std::endl;
+      else if (parallel && parameters.active_block_cells > 0)
+        pcout << "  Grid/Nodes = near material is for one rank so far: each rank keeps every node of its part "
+                 "of the grid"
+              << std::endl;
     }
 
     // Everything of the run but its points and grid, for a checkpoint (collective: the
@@ -643,7 +647,7 @@ namespace mpm
         {
           if (!engine)
             engine = make_engine<dim>(parameters.backend, lattice_grid<dim>(parameters), materials,
-                                      parameters.shape_function);
+                                      parameters.shape_function, parameters.active_block_cells);
           engine->load(saved.points, saved.labels); // in the saved order: the same sums as before
         }
       engine->set_sort_interval(parameters.sort_interval);
@@ -663,6 +667,49 @@ namespace mpm
       dropped_mass += held.removed_mass;
       ++n_resorts;
       drift_bound = 0; // every point is in its home cell now
+    }
+
+    // How far a point can be outside the cell it was sorted into (several ranks) or was in
+    // when the engine chose its nodes (one rank, nodes near the material): the largest
+    // distance at the last check plus the steps' bounds since, while that stays below the
+    // re-sort distance (the distance is 1-Lipschitz in the position, max-norm); the points'
+    // largest distance (a pass over the points and, on several ranks, a reduction) once it
+    // does. The re-sorts come at the same steps either way.
+    template <typename When>
+    double distance_outside_home_cells(const double dt, const When &when)
+    {
+      drift_bound += step_displacement_bound(dt);
+      double     distance = drift_bound;
+      const bool needed   = !(drift_bound < resort_at);
+      if (needed || verify_drift_bound)
+        {
+          distance = global_max(engine->max_distance_outside_home_cells());
+          n_home_checks += needed;
+          AssertThrow(needed || distance <= drift_bound,
+                      dealii::ExcMessage("Internal error (MPM_VERIFY_DRIFT_BOUND): a point is " +
+                                         dealii::Utilities::to_string(distance) +
+                                         " cells outside its home cell, beyond the bound " +
+                                         dealii::Utilities::to_string(drift_bound) + " " + when()));
+          if (needed)
+            drift_bound = distance;
+        }
+      return distance;
+    }
+
+    // Cells a point may move out of its home cell before the run re-sorts the points (several
+    // ranks) or the engine chooses the nodes near the material again (one rank): set once the
+    // engine exists. Pressure averaging on several ranks: a point's cell at the end of a step
+    // must be an owned or ghost cell of its rank (whose cell sums the exchange covers), i.e.
+    // less than one cell outside its home cell. Re-sorting at half a cell (GIMP's safe
+    // distance already) leaves a step's displacement of room; the check after each step
+    // asserts it.
+    void set_resort_distance()
+    {
+      if (!parallel)
+        resort_at = engine->follows_material() ? engine->active_node_margin() : 1e300;
+      else
+        resort_at = std::min(parameters.resort_distance * safe_distance_outside_home_cell(parameters.shape_function),
+                             parameters.pressure_averaging ? 0.5 : 1e300);
     }
 
     // A bound on how far (in cells, max-norm) any point moved in the step of length dt just

@@ -170,7 +170,7 @@ namespace mpm
     {
       if (cells_too && (g.cell_volume == nullptr || g.cell_pressure_volume == nullptr))
         throw std::invalid_argument("pressure averaging needs GridView::cell_volume and cell_pressure_volume");
-      return cells_too ? g.n_lattice_cells() : 0;
+      return !cells_too ? 0 : g.cell_sums_at_nodes ? g.n_nodes : g.n_lattice_cells();
     }
 
     // Item n of a node loop over max(n_nodes, n_cells) items: zeroes cell n's sums where
@@ -219,7 +219,7 @@ namespace mpm
                                                     const Real s_yy, const Real s_zz)
     {
       const Real mean = mean_normal_stress(s_xx, s_yy, s_zz);
-      const int  c    = g.lattice_cell(x);
+      const int  c    = g.cell_sum_entry(x);
       return g.cell_pressure_volume[c] / g.cell_volume[c] - mean;
     }
 
@@ -592,7 +592,7 @@ namespace mpm
       for (int d = 0; d < dim; ++d)
         x[d] = p.position[d][i];
       mean = mean_normal_stress(p.stress[0][i], p.stress[1][i], p.stress[2][i]);
-      return g.lattice_cell(x);
+      return g.cell_sum_entry(x);
     }
 
     // The first pass of the averaging for point i (not removed): V_p and V_p p_p into its

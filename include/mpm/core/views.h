@@ -58,6 +58,10 @@ namespace mpm
     // arrays provides none; the step then refuses pressure averaging.
     Real *cell_volume          = nullptr; // sum of V_p over the points of the cell
     Real *cell_pressure_volume = nullptr; // sum of V_p p_p
+    // Where the grid keeps only the nodes near the material (active_nodes.h), a cell's sums
+    // sit at its lowest vertex, a node of every cell that can hold a point: the arrays
+    // above are then n_nodes long, not one entry per lattice cell.
+    bool cell_sums_at_nodes = false;
 
     MPM_HOST_DEVICE int n_lattice_cells() const
     {
@@ -74,6 +78,22 @@ namespace mpm
     }
 
     MPM_HOST_DEVICE int n_lattice_nodes(const int d) const { return n_cells[d] + 1; }
+
+    // Entry of the pressure averaging's sums for the cell containing x (clamped like
+    // lattice_cell): the lattice cell, or its lowest vertex's node (cell_sums_at_nodes).
+    MPM_HOST_DEVICE int cell_sum_entry(const Real x[dim]) const
+    {
+      if (!cell_sums_at_nodes)
+        return lattice_cell(x);
+      long lattice = 0;
+      for (int d = dim - 1; d >= 0; --d)
+        {
+          long i  = static_cast<long>(std::floor((x[d] - origin[d]) / h));
+          i       = i < 0 ? 0 : (i >= n_cells[d] ? n_cells[d] - 1 : i);
+          lattice = lattice * (n_cells[d] + 1) + i;
+        }
+      return node_of_lattice(lattice);
+    }
 
     // Local node index of lattice node (i,j,k), or -1 outside the lattice.
     MPM_HOST_DEVICE int node(const int idx[dim]) const

@@ -66,6 +66,16 @@ namespace mpm
     // Steps between re-sorts of the points (Backend/Sort interval); engines that do not
     // re-sort ignore it.
     virtual void set_sort_interval(int /*steps*/) {}
+    // One rank, Grid/Nodes = near material: the engine keeps only the nodes near the points
+    // (active_nodes.h). The run refreshes them (refresh_active_nodes) before a point gets
+    // active_node_margin() cells out of the cell it was in at the last refresh; loading
+    // points refreshes them too.
+    virtual bool   follows_material() const { return false; }
+    virtual double active_node_margin() const { return 0; }
+    virtual void   refresh_active_nodes() {}
+    // Nodes the engine updates now, and the most it has had.
+    virtual long n_active_nodes() const { return 0; }
+    virtual long most_nodes() const { return 0; }
     // Replaces the material table (e.g. when plasticity is switched on).
     virtual void set_materials(const std::vector<MaterialParameters<double>> &materials) = 0;
   };
@@ -75,11 +85,13 @@ namespace mpm
   void check_backend(const std::string &backend);
 
   // One rank: the engine's own nodes on the lattice (lattice_grid: geometry and boundary
-  // masks). Throws naming Backend/Backend if the requested backend is not available.
+  // masks), all of them or, with active_block_cells > 0, those near the material in blocks
+  // of that many cells per axis. Throws naming Backend/Backend if the requested backend is
+  // not available.
   template <int dim>
   std::unique_ptr<Engine<dim>> make_engine(const std::string &backend, const HostGrid<dim, double> &lattice,
                                            const std::vector<MaterialParameters<double>> &materials,
-                                           ShapeFunction shape);
+                                           ShapeFunction shape, int active_block_cells = 0);
 
   // Several ranks: the nodes are the grid's (cpu: its vectors; cuda: the device's copy of
   // the rank's locally relevant nodes, exchanged through the grid's partitioner).

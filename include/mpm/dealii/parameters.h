@@ -48,6 +48,7 @@ namespace mpm
     // Grid
     std::vector<double> lower, upper;
     double              cell_size;
+    int                 active_block_cells = 0; // Nodes = near material: block edge in cells; 0: all nodes
     std::array<BoundaryType, 6> boundary{}; // by boundary id: x min, x max, y min, y max, z min, z max
     double                      friction_coefficient = 0; // mu of every face of type friction
 

@@ -1,0 +1,33 @@
+#!/bin/bash
+# Grid/Nodes = near material gives the results of Nodes = all bit for bit: runs a scene both
+# ways (overrides appended to both) and asserts that the full-precision particle tables of
+# every output are identical, that the near-material run kept fewer nodes than the lattice
+# has and chose them again at least MIN_REFRESHES times (so the refresh was exercised), with
+# the drift bound verified every step (MPM_VERIFY_DRIFT_BOUND).
+# Usage: nodes_near_material.sh EXE PRM OUTDIR MIN_REFRESHES [override lines...]
+set -eu
+exe=$1 prm=$2 out=$3 min_refreshes=$4
+shift 4
+here=$(dirname "$0")
+table=("subsection Output" "  set Write particle table = true" "end")
+bash "$here/run_scene.sh" "$exe" "$prm" "$out/all" 1 "${table[@]}" "$@" \
+  "subsection Grid" "  set Nodes = all" "end" > "$out-all.log" 2>&1 ||
+  { cat "$out-all.log"; echo "FAILED: the run with Nodes = all failed"; exit 1; }
+MPM_VERIFY_DRIFT_BOUND=1 bash "$here/run_scene.sh" "$exe" "$prm" "$out/near" 1 "${table[@]}" "$@" \
+  "subsection Grid" "  set Nodes = near material" "end" > "$out-near.log" 2>&1 ||
+  { cat "$out-near.log"; echo "FAILED: the run with Nodes = near material failed"; exit 1; }
+grep "nodes near the material" "$out-near.log"
+lattice=$(sed -n 's/.*material: [0-9]* of the \([0-9]*\) .*/\1/p' "$out-near.log")
+most=$(sed -n 's/.* at the end, \([0-9]*\) at most.*/\1/p' "$out-near.log")
+refreshes=$(sed -n 's/.*chosen again \([0-9]*\) times.*/\1/p' "$out-near.log")
+[ -n "$lattice" ] && [ -n "$most" ] && [ -n "$refreshes" ] || { echo "FAILED: no node report in the log"; exit 1; }
+[ "$most" -lt "$lattice" ] || { echo "FAILED: $most nodes kept, the lattice has $lattice"; exit 1; }
+[ "$refreshes" -ge "$min_refreshes" ] ||
+  { echo "FAILED: the nodes were chosen again $refreshes times, fewer than $min_refreshes"; exit 1; }
+n=0
+for f in "$out"/all/particle_table_*.csv; do
+  cmp "$f" "$out/near/$(basename "$f")" || { echo "FAILED: $(basename "$f") differs"; exit 1; }
+  n=$((n + 1))
+done
+[ "$n" -gt 0 ] || { echo "FAILED: no particle tables"; exit 1; }
+echo "$n particle tables identical; at most $most of $lattice nodes kept, chosen again $refreshes times"
