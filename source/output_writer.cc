@@ -129,17 +129,24 @@ namespace mpm
   } // namespace
 
   template <int dim>
-  GridSnapshot<dim>::GridSnapshot(const BackgroundGrid<dim> &grid, const unsigned int rank)
+  GridSnapshot<dim>::GridSnapshot(const BackgroundGrid<dim> &grid, const unsigned int rank,
+                                  const bool cells_with_mass_only)
     : rank(rank)
   {
-    for (const auto &cell : grid.dof_handler.active_cell_iterators())
-      if (cell->is_locally_owned())
-        cells.push_back(cell);
     nodal.push_back(grid.mass);
     for (int d = 0; d < dim; ++d)
       nodal.push_back(grid.velocity[d]);
     for (auto &field : nodal)
       field.update_ghost_values(); // as DataOut::add_data_vector's copy does
+    const auto has_mass = [&](const auto &cell) {
+      for (const unsigned int v : cell->vertex_indices())
+        if (nodal[0](cell->vertex_dof_index(v, 0)) != 0)
+          return true;
+      return false;
+    };
+    for (const auto &cell : grid.dof_handler.active_cell_iterators())
+      if (cell->is_locally_owned() && (!cells_with_mass_only || has_mass(cell)))
+        cells.push_back(cell);
   }
 
   template <int dim>
@@ -359,7 +366,7 @@ namespace mpm
   }
 
   template <int dim>
-  void OutputWriter<dim>::write_fields(const double time, BackgroundGrid<dim> &grid)
+  void OutputWriter<dim>::write_fields(const double time, BackgroundGrid<dim> &grid, const bool cells_with_mass_only)
   {
     finish();
     // What the background tasks read is copied now. DataOut::add_data_vector makes its own
@@ -369,7 +376,7 @@ namespace mpm
     std::shared_ptr<const GridSnapshot<dim>> grid_snapshot;
     if (write_grid)
       {
-        grid_snapshot = std::make_shared<const GridSnapshot<dim>>(grid, rank);
+        grid_snapshot = std::make_shared<const GridSnapshot<dim>>(grid, rank, cells_with_mass_only);
         grid_records.emplace_back(time, record_name("grid", counter));
       }
     if (write_particles)

@@ -254,7 +254,8 @@ namespace mpm
       if (initial_output_pending)
         {
           dealii::TimerOutput::Scope scope(timer, "output");
-          output->write_fields(0, *grid); // before the first step every nodal field is zero
+          // Before the first step every nodal field is zero (near the material: no cell has mass).
+          output->write_fields(0, *grid, engine->follows_material());
           initial_output_pending = false;
         }
     }
@@ -789,7 +790,7 @@ namespace mpm
       dealii::TimerOutput::Scope scope(timer, "output");
       engine->snapshot(output->next_snapshot());
       engine->nodal_to(*grid);
-      output->write_fields(time, *grid);
+      output->write_fields(time, *grid, engine->follows_material());
     }
   };
 } // namespace mpm

@@ -3,7 +3,8 @@
 # ways (overrides appended to both) and asserts that the full-precision particle tables of
 # every output are identical, that the near-material run kept fewer nodes than the lattice
 # has and chose them again at least MIN_REFRESHES times (so the refresh was exercised), with
-# the drift bound verified every step (MPM_VERIFY_DRIFT_BOUND).
+# the drift bound verified every step (MPM_VERIFY_DRIFT_BOUND); and that its grid files hold
+# fewer cells with the same nodal values wherever there is mass (compare_grid_mass.py).
 # Usage: nodes_near_material.sh EXE PRM OUTDIR MIN_REFRESHES [override lines...]
 set -eu
 exe=$1 prm=$2 out=$3 min_refreshes=$4
@@ -30,4 +31,5 @@ for f in "$out"/all/particle_table_*.csv; do
   n=$((n + 1))
 done
 [ "$n" -gt 0 ] || { echo "FAILED: no particle tables"; exit 1; }
+/usr/bin/python3 "$here/compare_grid_mass.py" "$out/all" "$out/near"
 echo "$n particle tables identical; at most $most of $lattice nodes kept, chosen again $refreshes times"

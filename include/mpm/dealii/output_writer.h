@@ -54,7 +54,9 @@ namespace mpm
   template <int dim>
   struct GridSnapshot
   {
-    GridSnapshot(const BackgroundGrid<dim> &grid, unsigned int rank);
+    // cells_with_mass_only: only the cells with mass at a vertex (Grid/Nodes = near
+    // material: the grid's files then follow the material too).
+    GridSnapshot(const BackgroundGrid<dim> &grid, unsigned int rank, bool cells_with_mass_only = false);
 
     std::vector<typename dealii::DoFHandler<dim>::active_cell_iterator> cells;
     std::vector<typename BackgroundGrid<dim>::Vector>                   nodal; // mass, velocity_x, ...
@@ -114,7 +116,8 @@ namespace mpm
     // position and every property in full precision (the .vtu files hold single
     // precision). Copies the nodal vectors (with their ghosts: MPI) before returning; the
     // rest may still be running on background threads when it returns.
-    void write_fields(double time, BackgroundGrid<dim> &grid);
+    // cells_with_mass_only: the grid files hold only the cells with mass at a vertex.
+    void write_fields(double time, BackgroundGrid<dim> &grid, bool cells_with_mass_only = false);
 
     // Waits for the writes in flight and rethrows their error, if any. Call it before the
     // triangulation or the DoFHandler change (repartition).
