@@ -129,34 +129,55 @@ namespace mpm
   } // namespace
 
   template <int dim>
-  GridSnapshot<dim>::GridSnapshot(const BackgroundGrid<dim> &grid, const unsigned int rank,
-                                  const bool cells_with_mass_only)
+  GridSnapshot<dim>::GridSnapshot(const BackgroundGrid<dim> &grid, const unsigned int rank)
     : rank(rank)
   {
+    for (const auto &cell : grid.dof_handler.active_cell_iterators())
+      if (cell->is_locally_owned())
+        cells.push_back(cell);
     nodal.push_back(grid.mass);
     for (int d = 0; d < dim; ++d)
       nodal.push_back(grid.velocity[d]);
     for (auto &field : nodal)
       field.update_ghost_values(); // as DataOut::add_data_vector's copy does
-    const auto has_mass = [&](const auto &cell) {
-      for (const unsigned int v : cell->vertex_indices())
-        if (nodal[0](cell->vertex_dof_index(v, 0)) != 0)
-          return true;
-      return false;
-    };
-    for (const auto &cell : grid.dof_handler.active_cell_iterators())
-      if (cell->is_locally_owned() && (!cells_with_mass_only || has_mass(cell)))
-        cells.push_back(cell);
   }
+
+  template <int dim>
+  GridSnapshot<dim>::GridSnapshot(LatticeCells cells)
+    : lattice_cells(std::move(cells))
+  {}
 
   template <int dim>
   void GridDataOut<dim>::build_patches(const GridSnapshot<dim> &snapshot, const int begin, const int end)
   {
     constexpr unsigned int n_vertices = dealii::GeometryInfo<dim>::vertices_per_cell;
-    const int              last       = end < 0 ? static_cast<int>(snapshot.cells.size()) : end;
-    const unsigned int     n_nodal    = snapshot.nodal.size();
+    const int              last       = end < 0 ? snapshot.n_cells() : end;
     patches.clear();
     patches.resize(std::max(last - begin, 0));
+    if (snapshot.cells.empty()) // the engine's lattice cells (no deal.II grid)
+      {
+        const auto        &lattice  = snapshot.lattice_cells;
+        const unsigned int n_fields = 1 + dim;
+        for (int c = begin; c < last; ++c)
+          {
+            auto &patch          = patches[c - begin];
+            patch.patch_index    = c - begin;
+            patch.reference_cell = dealii::ReferenceCells::get_hypercube<dim>();
+            patch.data.reinit(n_fields + 1, n_vertices);
+            for (unsigned int v = 0; v < n_vertices; ++v)
+              {
+                patch.vertices[v] = lattice.lower_corner[c];
+                for (int d = 0; d < dim; ++d)
+                  if ((v >> d) & 1)
+                    patch.vertices[v][d] += lattice.h;
+                for (unsigned int k = 0; k < n_fields; ++k)
+                  patch.data(k, v) = lattice.vertex_values[(std::size_t(c) * n_vertices + v) * n_fields + k];
+                patch.data(n_fields, v) = snapshot.rank;
+              }
+          }
+        return;
+      }
+    const unsigned int n_nodal = snapshot.nodal.size();
     for (int c = begin; c < last; ++c)
       {
         const auto &cell  = snapshot.cells[c];
@@ -366,19 +387,28 @@ namespace mpm
   }
 
   template <int dim>
-  void OutputWriter<dim>::write_fields(const double time, BackgroundGrid<dim> &grid, const bool cells_with_mass_only)
+  void OutputWriter<dim>::write_fields(const double time, BackgroundGrid<dim> &grid)
   {
     finish();
     // What the background tasks read is copied now. DataOut::add_data_vector makes its own
     // ghosted copy of each vector (MPI: here, on this thread); build_patches then reads
     // those copies and the DoFHandler as it is (it changes only in a repartition, which
     // calls finish() first) and does no communication.
-    std::shared_ptr<const GridSnapshot<dim>> grid_snapshot;
+    write(time, write_grid ? std::make_shared<const GridSnapshot<dim>>(grid, rank) : nullptr);
+  }
+
+  template <int dim>
+  void OutputWriter<dim>::write_fields(const double time, typename GridSnapshot<dim>::LatticeCells cells)
+  {
+    finish();
+    write(time, write_grid ? std::make_shared<const GridSnapshot<dim>>(std::move(cells)) : nullptr);
+  }
+
+  template <int dim>
+  void OutputWriter<dim>::write(const double time, std::shared_ptr<const GridSnapshot<dim>> grid_snapshot)
+  {
     if (write_grid)
-      {
-        grid_snapshot = std::make_shared<const GridSnapshot<dim>>(grid, rank, cells_with_mass_only);
-        grid_records.emplace_back(time, record_name("grid", counter));
-      }
+      grid_records.emplace_back(time, record_name("grid", counter));
     if (write_particles)
       particle_records.emplace_back(time, record_name("particles", counter));
 
@@ -387,7 +417,7 @@ namespace mpm
     const unsigned int K = pieces_per_rank;
     auto grid_task = [this, grid_snapshot, K, counter = counter, records = grid_records]() {
       std::vector<std::function<void()>> writes;
-      const int                          n = grid_snapshot->cells.size();
+      const int                          n = grid_snapshot->n_cells();
       for (unsigned int k = 0; k < K; ++k)
         writes.emplace_back([&, k]() {
           GridDataOut<dim> out;

@@ -269,16 +269,19 @@ namespace mpm
     // at the end of setup().
     if (!s.parallel)
       {
-        s.timer.enter_subsection(s.beside_grid);
-        s.grid_build = std::async(std::launch::async, [&parameters, comm = s.communicator, generation]() {
-          const auto                     start = std::chrono::steady_clock::now();
-          typename State::GridAndPoints built;
-          built.grid   = std::make_unique<BackgroundGrid<dim>>(parameters, comm);
-          built.points = std::make_unique<MaterialPoints<dim>>(*built.grid, parameters);
-          built.points->insert(generation.get());
-          built.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-          return built;
-        });
+        if (s.builds_dealii_grid()) // not with Grid/Nodes = near material
+          {
+            s.timer.enter_subsection(s.beside_grid);
+            s.grid_build = std::async(std::launch::async, [&parameters, comm = s.communicator, generation]() {
+              const auto                     start = std::chrono::steady_clock::now();
+              typename State::GridAndPoints built;
+              built.grid   = std::make_unique<BackgroundGrid<dim>>(parameters, comm);
+              built.points = std::make_unique<MaterialPoints<dim>>(*built.grid, parameters);
+              built.points->insert(generation.get());
+              built.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+              return built;
+            });
+          }
         const auto start = std::chrono::steady_clock::now();
         count_points();
         HostPoints<dim, double> host;

@@ -79,9 +79,11 @@ namespace mpm
     // cells (one rank: all, including those that left the grid, as the engine held them).
     const unsigned int rank = dealii::Utilities::MPI::this_mpi_process(s.communicator);
     s.timer.enter_subsection("setup: grid");
-    s.grid   = std::make_unique<BackgroundGrid<dim>>(parameters, s.communicator);
-    s.points = std::make_unique<MaterialPoints<dim>>(*s.grid, parameters);
-    const BackgroundGrid<dim> &grid = *s.grid;
+    if (s.builds_dealii_grid())
+      {
+        s.grid   = std::make_unique<BackgroundGrid<dim>>(parameters, s.communicator);
+        s.points = std::make_unique<MaterialPoints<dim>>(*s.grid, parameters);
+      }
     const PointSnapshot<dim>   saved =
       checkpoint::read_points<dim>(folder, r, [&](const HostPoints<dim, double> &p, const int i) {
         if (!s.parallel)
@@ -98,15 +100,18 @@ namespace mpm
         double x[dim];
         for (int d = 0; d < dim; ++d)
           x[d] = p.position[d][i];
-        return p.material[i] >= 0 && grid.owned_cell(grid.lattice_cell_of(x)) != grid.triangulation.end();
+        return p.material[i] >= 0 && s.grid->owned_cell(s.grid->lattice_cell_of(x)) != s.grid->triangulation.end();
       });
     AssertThrow(saved.points.n_state_variables() == static_cast<int>(parameters.state_variable_names().size()),
                 dealii::ExcMessage("--resume: the points of '" + folder + "': " +
                                    state_variable_count_mismatch(saved.points.n_state_variables(),
                                                                  parameters.state_variable_names())));
-    if (!s.parallel)
-      s.points->replace(saved);
-    s.points->n_sent = rank == 0 ? r.n_sent : 0;
+    if (s.points) // not on one rank with Grid/Nodes = near material
+      {
+        if (!s.parallel)
+          s.points->replace(saved);
+        s.points->n_sent = rank == 0 ? r.n_sent : 0;
+      }
     if (rank == 0) // the sums over ranks
       {
         s.n_dropped    += r.n_dropped;

@@ -254,8 +254,7 @@ namespace mpm
       if (initial_output_pending)
         {
           dealii::TimerOutput::Scope scope(timer, "output");
-          // Before the first step every nodal field is zero (near the material: no cell has mass).
-          output->write_fields(0, *grid, engine->follows_material());
+          output->write_fields(0, *grid); // before the first step every nodal field is zero
           initial_output_pending = false;
         }
     }
@@ -697,6 +696,11 @@ namespace mpm
       return distance;
     }
 
+    // Whether the run builds deal.II's grid and ParticleHandler of the whole box: not on one
+    // rank with Grid/Nodes = near material, whose engine keeps only the nodes near the
+    // points and writes the grid files from them (cost and memory follow the material).
+    bool builds_dealii_grid() const { return parallel || parameters.active_block_cells == 0; }
+
     // Cells a point may move out of its home cell before the run re-sorts the points (several
     // ranks) or the engine chooses the nodes near the material again (one rank): set once the
     // engine exists. Pressure averaging on several ranks: a point's cell at the end of a step
@@ -789,8 +793,14 @@ namespace mpm
       join_grid();
       dealii::TimerOutput::Scope scope(timer, "output");
       engine->snapshot(output->next_snapshot());
+      if (!grid) // one rank, nodes near the material: the grid files show the engine's cells
+        {
+          typename GridSnapshot<dim>::LatticeCells cells;
+          engine->cells_with_mass(cells);
+          return output->write_fields(time, std::move(cells));
+        }
       engine->nodal_to(*grid);
-      output->write_fields(time, *grid, engine->follows_material());
+      output->write_fields(time, *grid);
     }
   };
 } // namespace mpm

@@ -13,6 +13,7 @@
 #include <mpm/core/diagnostics.h>
 #include <mpm/core/step.h>
 #include <mpm/dealii/material_points.h>
+#include <mpm/dealii/output_writer.h>
 
 #include <limits>
 #include <memory>
@@ -73,6 +74,12 @@ namespace mpm
     virtual bool   follows_material() const { return false; }
     virtual double active_node_margin() const { return 0; }
     virtual void   refresh_active_nodes() {}
+    // For the grid output without deal.II's grid (one rank, nodes near the material): the
+    // lattice cells with mass at a vertex, in lattice order, with their vertices' fields.
+    virtual void cells_with_mass(typename GridSnapshot<dim>::LatticeCells & /*cells*/)
+    {
+      AssertThrow(false, dealii::ExcMessage("Internal: this engine keeps no nodes of its own to write."));
+    }
     // Nodes the engine updates now, and the most it has had.
     virtual long n_active_nodes() const { return 0; }
     virtual long most_nodes() const { return 0; }

@@ -20,6 +20,7 @@
 #include <atomic>
 #include <fstream>
 #include <future>
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
@@ -54,13 +55,26 @@ namespace mpm
   template <int dim>
   struct GridSnapshot
   {
-    // cells_with_mass_only: only the cells with mass at a vertex (Grid/Nodes = near
-    // material: the grid's files then follow the material too).
-    GridSnapshot(const BackgroundGrid<dim> &grid, unsigned int rank, bool cells_with_mass_only = false);
+    GridSnapshot(const BackgroundGrid<dim> &grid, unsigned int rank);
+
+    // One rank with Grid/Nodes = near material, where deal.II's grid of the box is not built:
+    // the engine's lattice cells with mass at a vertex (Engine::cells_with_mass), each given by
+    // its lower corner and its vertices' fields.
+    struct LatticeCells
+    {
+      double                              h = 0;
+      std::vector<dealii::Point<dim>>     lower_corner;
+      // Per cell, per vertex in deal.II's order (x fastest), the nodal mass then velocity.
+      std::vector<double>                 vertex_values;
+    };
+    explicit GridSnapshot(LatticeCells cells);
 
     std::vector<typename dealii::DoFHandler<dim>::active_cell_iterator> cells;
     std::vector<typename BackgroundGrid<dim>::Vector>                   nodal; // mass, velocity_x, ...
-    float                                                                rank;
+    LatticeCells                                                         lattice_cells; // used where cells is empty
+    float                                                                rank = 0;
+
+    int n_cells() const { return static_cast<int>(cells.empty() ? lattice_cells.lower_corner.size() : cells.size()); }
   };
 
   // The patches deal.II's DataOut<dim> builds for the grid's Q1 fields (one per cell: its
@@ -116,8 +130,10 @@ namespace mpm
     // position and every property in full precision (the .vtu files hold single
     // precision). Copies the nodal vectors (with their ghosts: MPI) before returning; the
     // rest may still be running on background threads when it returns.
-    // cells_with_mass_only: the grid files hold only the cells with mass at a vertex.
-    void write_fields(double time, BackgroundGrid<dim> &grid, bool cells_with_mass_only = false);
+    void write_fields(double time, BackgroundGrid<dim> &grid);
+    // The same without deal.II's grid (one rank, Grid/Nodes = near material): the grid files
+    // show the engine's cells with mass.
+    void write_fields(double time, typename GridSnapshot<dim>::LatticeCells cells);
 
     // Waits for the writes in flight and rethrows their error, if any. Call it before the
     // triangulation or the DoFHandler change (repartition).
@@ -147,6 +163,10 @@ namespace mpm
     double       waited_seconds() const { return waited; }
 
   private:
+    // Writes the files of time t from the grid's snapshot (null: no grid files) and the
+    // points' (next_snapshot), on background threads where asked.
+    void write(double time, std::shared_ptr<const GridSnapshot<dim>> grid_snapshot);
+
     MPI_Comm                          communicator;
     unsigned int                      rank, n_ranks;
     std::string                       output_directory;
