@@ -38,15 +38,23 @@ namespace mpm
   }
 
   template <int dim>
-  HostGrid<dim, double> lattice_grid(const Parameters &parameters)
+  HostGrid<dim, double> lattice_grid(const Parameters &parameters, const bool nodal_arrays)
   {
     const HostGrid<dim, double> lattice = lattice_geometry<dim>(parameters);
     HostGrid<dim, double>       grid;
-    grid.make_dense(lattice.origin, lattice.h, lattice.n_cells);
+    long                        n_nodes = 1;
+    for (int d = 0; d < dim; ++d)
+      n_nodes *= lattice.n_cells[d] + 1;
+    if (nodal_arrays)
+      grid.make_dense(lattice.origin, lattice.h, lattice.n_cells);
+    else
+      {
+        grid = lattice;
+        grid.fixed_components.assign(n_nodes, 0);
+      }
     // A node on face id (x min, x max, y min, ...) takes that face's mask: no-slip fixes
     // every component, free-slip the normal one, friction sets bit id of its friction
     // mask; edges and corners combine their faces'.
-    const long n_nodes = static_cast<long>(grid.mass.size());
     if (has_friction_face(parameters.boundary))
       {
         grid.friction_faces.assign(n_nodes, 0);
@@ -347,8 +355,8 @@ namespace mpm
   template class BackgroundGrid<3>;
   template HostGrid<2, double> lattice_geometry<2>(const Parameters &);
   template HostGrid<3, double> lattice_geometry<3>(const Parameters &);
-  template HostGrid<2, double> lattice_grid<2>(const Parameters &);
-  template HostGrid<3, double> lattice_grid<3>(const Parameters &);
+  template HostGrid<2, double> lattice_grid<2>(const Parameters &, bool);
+  template HostGrid<3, double> lattice_grid<3>(const Parameters &, bool);
   template void BackgroundGrid<2>::sum_nodal(double *const *, int) const;
   template void BackgroundGrid<3>::sum_nodal(double *const *, int) const;
   template void BackgroundGrid<2>::sum_nodal(float *const *, int) const;

@@ -9,6 +9,7 @@
 #include <deal.II/base/parallel.h>
 
 #ifdef MPM_CUDA_ENGINE
+#  include <mpm/core/active_nodes.h>
 #  include <mpm/cuda/device_engine.h>
 
 #  if __has_include(<mpi-ext.h>)
@@ -83,14 +84,54 @@ namespace mpm
     class CudaEngine : public Engine<dim>
     {
     public:
-      // One rank: the device keeps the lattice's nodes, no ghost nodes, no exchange.
+      // One rank: the device keeps the lattice's nodes, no ghost nodes, no exchange; with
+      // active_block_cells > 0 only those near the points (keep_nodes_near_points), chosen
+      // when points are loaded and by refresh_active_nodes(), the device starting with none.
       CudaEngine(HostGrid<dim, double> lattice, const std::vector<MaterialParameters<double>> &materials,
-                 const ShapeFunction shape)
+                 const ShapeFunction shape, const int active_block_cells)
         : materials(materials)
         , shape(shape)
+        , active_block_cells(active_block_cells)
       {
-        device = std::make_unique<cuda::DeviceEngine<dim>>(make_grid_view<dim, double>(lattice), materials, shape,
-                                                           nullptr);
+        GridView<dim, double> view = make_grid_view<dim, double>(lattice);
+        if (active_block_cells > 0) // no node until the points are loaded
+          {
+            lattice_fixed_components = lattice.fixed_components;
+            lattice_friction_faces   = lattice.friction_faces;
+            view.lattice_to_node     = nullptr;
+            view.n_nodes             = 0; // (the friction coefficients are taken, the masks later)
+          }
+        device = std::make_unique<cuda::DeviceEngine<dim>>(view, materials, shape, nullptr);
+      }
+
+      bool follows_material() const override { return active_block_cells > 0; }
+
+      double active_node_margin() const override
+      {
+        return follows_material() ? mpm::active_node_margin(shape, active_block_cells) : 0;
+      }
+
+      void refresh_active_nodes() override
+      {
+        if (!follows_material())
+          return;
+        const long n = device->keep_nodes_near_points(active_block_cells, lattice_fixed_components,
+                                                      lattice_friction_faces);
+        most_active_nodes = std::max(most_active_nodes, n);
+        active_nodes      = n;
+      }
+
+      long n_active_nodes() const override { return active_nodes; }
+
+      long most_nodes() const override { return most_active_nodes; }
+
+      void cells_with_mass(typename GridSnapshot<dim>::LatticeCells &out) override
+      {
+        AssertThrow(follows_material(), dealii::ExcMessage("Internal: cells_with_mass() needs Nodes = near material."));
+        HostGrid<dim, double> nodes;
+        std::vector<long>     lattice_of_node;
+        device->download_kept_nodes(nodes, lattice_of_node);
+        out = lattice_cells_with_mass(nodes, lattice_of_node);
       }
 
       // Several ranks: the device keeps this rank's locally relevant nodes, numbered as the
@@ -208,7 +249,7 @@ namespace mpm
         device->upload_points(p);
         labels_on_device_only = false;
         if (shared_grid == nullptr)
-          return;
+          return refresh_active_nodes();
         // Several ranks: the labels travel with the points at re-sorts, on the device.
         std::vector<std::vector<double>> arrays(1 + dim);
         arrays[0].assign(labels->id.begin(), labels->id.end());
@@ -262,9 +303,9 @@ namespace mpm
 
       double max_distance_outside_home_cells() override
       {
-        AssertThrow(shared_grid != nullptr,
+        AssertThrow(shared_grid != nullptr || follows_material(),
                     dealii::ExcMessage("Internal: the home cells are known only for points loaded from the "
-                                       "ParticleHandler."));
+                                       "ParticleHandler or where the nodes follow the points."));
         return device->max_distance_outside_home_cells();
       }
 
@@ -284,6 +325,11 @@ namespace mpm
       BackgroundGrid<dim>                    *shared_grid = nullptr;
       std::vector<MaterialParameters<double>> materials; // the latest table, for a rebuild
       ShapeFunction                           shape;
+      // One rank, nodes near the points: the block size (0: every node), the whole
+      // lattice's boundary masks, the nodes kept now and the most kept.
+      int                       active_block_cells = 0;
+      std::vector<std::uint8_t> lattice_fixed_components, lattice_friction_faces;
+      long                      active_nodes = 0, most_active_nodes = 0;
       int                                     sort_interval = -1; // -1: the device's default
       // The partition the device's nodes were built for (kept alive, so a new one cannot
       // reuse its address).
@@ -421,15 +467,16 @@ namespace mpm
   template <int dim>
   std::unique_ptr<Engine<dim>> make_cuda_engine(const HostGrid<dim, double> &lattice,
                                                 const std::vector<MaterialParameters<double>> &materials,
-                                                const ShapeFunction shape)
+                                                const ShapeFunction shape, const int active_block_cells)
   {
 #ifdef MPM_CUDA_ENGINE
     check_models(materials);
     check_device(MPI_COMM_SELF);
     cuda::use_device_of_local_rank(0);
     std::cout << "  CUDA device: " << cuda::device_description() << std::endl; // one rank
-    return std::make_unique<CudaEngine<dim>>(lattice, materials, shape);
+    return std::make_unique<CudaEngine<dim>>(lattice, materials, shape, active_block_cells);
 #else
+    (void)active_block_cells;
     (void)lattice;
     (void)materials;
     (void)shape;
@@ -474,9 +521,11 @@ namespace mpm
   }
 
   template std::unique_ptr<Engine<2>> make_cuda_engine(const HostGrid<2, double> &,
-                                                       const std::vector<MaterialParameters<double>> &, ShapeFunction);
+                                                       const std::vector<MaterialParameters<double>> &, ShapeFunction,
+                                                       int);
   template std::unique_ptr<Engine<3>> make_cuda_engine(const HostGrid<3, double> &,
-                                                       const std::vector<MaterialParameters<double>> &, ShapeFunction);
+                                                       const std::vector<MaterialParameters<double>> &, ShapeFunction,
+                                                       int);
   template std::unique_ptr<Engine<2>> make_cuda_engine(BackgroundGrid<2> &,
                                                        const std::vector<MaterialParameters<double>> &, ShapeFunction);
   template std::unique_ptr<Engine<3>> make_cuda_engine(BackgroundGrid<3> &,

@@ -115,60 +115,7 @@ namespace mpm
       void cells_with_mass(typename GridSnapshot<dim>::LatticeCells &out) override
       {
         AssertThrow(follows_material(), dealii::ExcMessage("Internal: cells_with_mass() needs Nodes = near material."));
-        const int *n_cells = own_nodes.n_cells;
-        // The cells around every node with mass: the node is vertex `corner` of the cell
-        // whose lower corner is the node minus corner's bits.
-        std::vector<long> cells;
-        for (std::size_t node = 0; node < lattice_of_node.size(); ++node)
-          {
-            if (own_nodes.mass[node] == 0)
-              continue;
-            int idx[dim];
-            own_nodes.lattice_coordinates(lattice_of_node[node], idx);
-            for (int corner = 0; corner < (1 << dim); ++corner)
-              {
-                long cell = 0;
-                bool in   = true;
-                for (int d = dim - 1; d >= 0; --d)
-                  {
-                    const int i = idx[d] - ((corner >> d) & 1);
-                    in          = in && i >= 0 && i < n_cells[d];
-                    cell        = cell * n_cells[d] + i;
-                  }
-                if (in)
-                  cells.push_back(cell);
-              }
-          }
-        std::sort(cells.begin(), cells.end());
-        cells.erase(std::unique(cells.begin(), cells.end()), cells.end());
-        constexpr int n_vertices = 1 << dim;
-        out.h                    = own_nodes.h;
-        out.lower_corner.resize(cells.size());
-        out.vertex_values.assign(cells.size() * n_vertices * (1 + dim), 0.0);
-        for (std::size_t c = 0; c < cells.size(); ++c)
-          {
-            int  idx[dim];
-            long rest = cells[c];
-            for (int d = 0; d < dim; ++d)
-              {
-                idx[d] = static_cast<int>(rest % n_cells[d]);
-                rest /= n_cells[d];
-                out.lower_corner[c][d] = own_nodes.origin[d] + idx[d] * own_nodes.h;
-              }
-            for (int v = 0; v < n_vertices; ++v)
-              {
-                long lattice = 0;
-                for (int d = dim - 1; d >= 0; --d)
-                  lattice = lattice * (n_cells[d] + 1) + idx[d] + ((v >> d) & 1);
-                const int node = own_nodes.lattice_to_node[lattice];
-                if (node < 0) // not kept: no point reaches it
-                  continue;
-                double *values = &out.vertex_values[(c * n_vertices + v) * (1 + dim)];
-                values[0]      = own_nodes.mass[node];
-                for (int d = 0; d < dim; ++d)
-                  values[1 + d] = own_nodes.velocity[d][node];
-              }
-          }
+        out = lattice_cells_with_mass(own_nodes, lattice_of_node);
       }
 
       long n_active_nodes() const override { return static_cast<long>(own_nodes.mass.size()); }
@@ -285,13 +232,8 @@ namespace mpm
                                            const ShapeFunction shape, const int active_block_cells)
   {
     check_backend(backend);
-    if (backend == "cuda")
-      {
-        AssertThrow(active_block_cells == 0,
-                    dealii::ExcMessage("Parameter 'Grid/Nodes': 'near material' runs on the cpu backend only so "
-                                       "far (allowed with Backend = cuda: all)."));
-        return make_cuda_engine<dim>(lattice, materials, shape); // throws where no device is found
-      }
+    if (backend == "cuda") // throws where no device is found
+      return make_cuda_engine<dim>(lattice, materials, shape, active_block_cells);
     return std::make_unique<CpuEngine<dim>>(lattice, materials, shape, active_block_cells);
   }
 

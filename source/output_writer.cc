@@ -1,5 +1,7 @@
 #include <mpm/dealii/output_writer.h>
 
+#include <algorithm>
+
 #include <deal.II/base/exceptions.h>
 #include <deal.II/base/mpi.h>
 #include <deal.II/base/utilities.h>
@@ -140,6 +142,68 @@ namespace mpm
       nodal.push_back(grid.velocity[d]);
     for (auto &field : nodal)
       field.update_ghost_values(); // as DataOut::add_data_vector's copy does
+  }
+
+  template <int dim>
+  typename GridSnapshot<dim>::LatticeCells lattice_cells_with_mass(const HostGrid<dim, double> &nodes,
+                                                                   const std::vector<long>     &lattice_of_node)
+  {
+    const int *n_cells = nodes.n_cells;
+    // The cells around every node with mass: the node is vertex `corner` of the cell whose
+    // lower corner is the node minus corner's bits.
+    std::vector<long> cells;
+    for (std::size_t node = 0; node < lattice_of_node.size(); ++node)
+      {
+        if (nodes.mass[node] == 0)
+          continue;
+        int idx[dim];
+        nodes.lattice_coordinates(lattice_of_node[node], idx);
+        for (int corner = 0; corner < (1 << dim); ++corner)
+          {
+            long cell = 0;
+            bool in   = true;
+            for (int d = dim - 1; d >= 0; --d)
+              {
+                const int i = idx[d] - ((corner >> d) & 1);
+                in          = in && i >= 0 && i < n_cells[d];
+                cell        = cell * n_cells[d] + i;
+              }
+            if (in)
+              cells.push_back(cell);
+          }
+      }
+    std::sort(cells.begin(), cells.end());
+    cells.erase(std::unique(cells.begin(), cells.end()), cells.end());
+    constexpr int                            n_vertices = 1 << dim;
+    typename GridSnapshot<dim>::LatticeCells out;
+    out.h = nodes.h;
+    out.lower_corner.resize(cells.size());
+    out.vertex_values.assign(cells.size() * n_vertices * (1 + dim), 0.0);
+    for (std::size_t c = 0; c < cells.size(); ++c)
+      {
+        int  idx[dim];
+        long rest = cells[c];
+        for (int d = 0; d < dim; ++d)
+          {
+            idx[d] = static_cast<int>(rest % n_cells[d]);
+            rest /= n_cells[d];
+            out.lower_corner[c][d] = nodes.origin[d] + idx[d] * nodes.h;
+          }
+        for (int v = 0; v < n_vertices; ++v)
+          {
+            long lattice = 0;
+            for (int d = dim - 1; d >= 0; --d)
+              lattice = lattice * (n_cells[d] + 1) + idx[d] + ((v >> d) & 1);
+            const int node = nodes.lattice_to_node[lattice];
+            if (node < 0) // not kept: no point reaches it
+              continue;
+            double *values = &out.vertex_values[(c * n_vertices + v) * (1 + dim)];
+            values[0]      = nodes.mass[node];
+            for (int d = 0; d < dim; ++d)
+              values[1 + d] = nodes.velocity[d][node];
+          }
+      }
+    return out;
   }
 
   template <int dim>
@@ -495,6 +559,10 @@ namespace mpm
 
   template struct GridSnapshot<2>;
   template struct GridSnapshot<3>;
+  template typename GridSnapshot<2>::LatticeCells lattice_cells_with_mass(const HostGrid<2, double> &,
+                                                                          const std::vector<long> &);
+  template typename GridSnapshot<3>::LatticeCells lattice_cells_with_mass(const HostGrid<3, double> &,
+                                                                          const std::vector<long> &);
   template class GridDataOut<2>;
   template class GridDataOut<3>;
   template class OutputWriter<2>;

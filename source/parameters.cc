@@ -115,9 +115,10 @@ namespace mpm
                       "Which nodes of the grid the step keeps and updates. all: every node of the box. near "
                       "material: only those of the blocks of Active block size^dim cells that hold a material "
                       "point or touch such a block, chosen again whenever a point has moved far enough to need "
-                      "others; cost and memory of the step then follow the material, not the box (the results "
-                      "are the same bit for bit). One rank and Backend = cpu only for now; on several ranks each "
-                      "rank keeps every node of its part of the grid.");
+                      "others; cost and memory then follow the material, not the box (the results are the same: "
+                      "bit for bit on the CPU, to round-off on the GPU). The grid files then show only the cells "
+                      "with mass, and on one rank deal.II's grid of the whole box is not built. One rank only for "
+                      "now; on several ranks each rank keeps every node of its part of the grid.");
     prm.declare_entry("Active block size", "4", Patterns::Integer(1, 64),
                       "Nodes = near material: edge of the blocks, in cells. Every cell within this many cells "
                       "of a point's cell is kept; larger blocks choose the nodes less often but keep more.");
@@ -766,8 +767,6 @@ namespace mpm
     backend       = prm.get("Backend");
     sort_interval = prm.get_integer("Sort interval");
     prm.leave_subsection();
-    if (backend == "cuda" && active_block_cells > 0)
-      fail("Grid/Nodes", "near material runs on the cpu backend only for now (Backend = cpu, or Nodes = all).");
     if (backend == "cuda")
       for (unsigned int i = 0; i < materials.size(); ++i)
         {

@@ -290,7 +290,7 @@ namespace mpm
         labels->state_variable_names = parameters.state_variable_names();
         if (cuda_ready.valid())
           cuda_ready.get();
-        s.engine = make_engine<dim>(parameters.backend, lattice_grid<dim>(parameters), s.materials,
+        s.engine = make_engine<dim>(parameters.backend, lattice_grid<dim>(parameters, parameters.active_block_cells == 0), s.materials,
                                     parameters.shape_function, parameters.active_block_cells);
         s.engine->set_sort_interval(parameters.sort_interval);
         s.engine->load(host, std::move(labels));

@@ -646,7 +646,7 @@ namespace mpm
       else
         {
           if (!engine)
-            engine = make_engine<dim>(parameters.backend, lattice_grid<dim>(parameters), materials,
+            engine = make_engine<dim>(parameters.backend, lattice_grid<dim>(parameters, parameters.active_block_cells == 0), materials,
                                       parameters.shape_function, parameters.active_block_cells);
           engine->load(saved.points, saved.labels); // in the saved order: the same sums as before
         }

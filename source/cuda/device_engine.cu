@@ -4,6 +4,7 @@
 #include <mpm/core/backend/cuda_backend.h>
 #include <mpm/core/backend/cuda_point_order.h>
 #include <mpm/core/backend/cuda_storage.h>
+#include <mpm/core/active_nodes.h>
 #include <mpm/core/migration.h>
 #include <mpm/cuda/device_engine.h>
 
@@ -376,6 +377,13 @@ namespace mpm
       // The last step's pressure averaging is left to the next step's P2G (explicit_step);
       // download_points finishes it first.
       bool                         averaging_pending = false;
+      // Nodes near the points (keep_nodes_near_points): the lattice index of each device
+      // node (empty: the slab from node_offset on), the lookup on the host, and the cell sums
+      // at the nodes.
+      std::vector<long>            lattice_of_node;
+      std::vector<int>             lattice_to_node;
+      bool                         cell_sums_at_nodes = false;
+      DeviceArray<std::uint8_t>    block_marks; // blocks holding a point's cell (keep_nodes_near_points)
 
       // The device grid's view, with the averaging's cell arrays where they exist.
       GridView<dim, double> view()
@@ -383,7 +391,21 @@ namespace mpm
         GridView<dim, double> g = grid.view();
         if (cell_volume.size() > 0)
           set_cell_arrays(g, cell_volume.data(), cell_pressure_volume.data(), HasCellArrays<GridView<dim, double>>());
+        g.cell_sums_at_nodes = cell_sums_at_nodes;
         return g;
+      }
+
+      // Entries of the pressure averaging's cell sums: one per lattice cell, or per node.
+      long n_cell_sums() const { return cell_sums_at_nodes ? grid.n_nodes() : n_lattice_cells; }
+
+      // Applies the last step's averaging if the next step's P2G was to do it.
+      void finish_pending_averaging()
+      {
+        if (averaging_pending)
+          {
+            stages::finish_pressure_averaging(backend, view(), points.view());
+            averaging_pending = false;
+          }
       }
     };
 
@@ -491,11 +513,7 @@ namespace mpm
     template <int dim>
     void DeviceEngine<dim>::download_points(HostPoints<dim, double> &p) const
     {
-      if (impl->averaging_pending)
-        {
-          stages::finish_pressure_averaging(impl->backend, impl->view(), impl->points.view());
-          impl->averaging_pending = false;
-        }
+      impl->finish_pending_averaging();
       impl->backend.synchronize();
       impl->order.download_in_reference_order(impl->backend, impl->points, p);
     }
@@ -521,7 +539,8 @@ namespace mpm
       std::vector<double> staging(dg.mass.size());
       std::vector<int>    host_node(staging.size());
       for (size_t b = 0; b < host_node.size(); ++b)
-        host_node[b] = g.node_of_lattice(impl->node_offset + static_cast<long>(b));
+        host_node[b] = g.node_of_lattice(impl->lattice_of_node.empty() ? impl->node_offset + static_cast<long>(b) :
+                                                                         impl->lattice_of_node[b]);
       auto download = [&](double *to, const DeviceArray<double> &from) {
         from.download(staging);
         for (size_t b = 0; b < staging.size(); ++b)
@@ -558,8 +577,8 @@ namespace mpm
             throw std::runtime_error("pressure averaging is not available in this build of the CUDA engine");
           if (impl->cell_volume.size() == 0)
             {
-              impl->cell_volume.resize(impl->n_lattice_cells);
-              impl->cell_pressure_volume.resize(impl->n_lattice_cells);
+              impl->cell_volume.resize(impl->n_cell_sums());
+              impl->cell_pressure_volume.resize(impl->n_cell_sums());
             }
           g = impl->view();
         }
@@ -835,6 +854,76 @@ namespace mpm
     int DeviceEngine<dim>::n_points() const
     {
       return impl->points.size();
+    }
+
+    template <int dim>
+    int DeviceEngine<dim>::keep_nodes_near_points(const int block_cells, const std::vector<std::uint8_t> &fixed,
+                                                  const std::vector<std::uint8_t> &friction)
+    {
+      impl->finish_pending_averaging(); // its cell sums live in the arrays replaced below
+      // On the device: every point's current cell becomes its home cell (upload order), and
+      // the blocks holding a point's cell are marked; only the marks come to the host.
+      const int                     n = impl->points.size();
+      const PointsView<dim, double> p = impl->points.view();
+      const GridView<dim, double>   g = impl->grid.view();
+      impl->home_cells.resize(n);
+      impl->block_marks.resize(n_blocks<dim>(g.n_cells, block_cells));
+      impl->block_marks.fill_bytes(0);
+      long               *home     = impl->home_cells.data();
+      std::uint8_t       *marks    = impl->block_marks.data();
+      const int          *original = impl->order.original_index(); // slot -> upload order
+      if (n > 0)
+        impl->backend.for_each_node(n, [=] MPM_HOST_DEVICE(const int i) {
+          double x[dim];
+          for (int d = 0; d < dim; ++d)
+            x[d] = p.position[d][i];
+          const long cell   = lattice_cell_containing<dim>(g.origin, g.h, g.n_cells, x);
+          home[original[i]] = cell;
+          if (p.material[i] >= 0)
+            marks[block_of_cell<dim>(cell, g.n_cells, block_cells)] = 1; // the same value from every writer
+        });
+      impl->home_by_slot_stale = true;
+      std::vector<std::uint8_t> holding;
+      impl->block_marks.download(holding);
+      ActiveNodes active = nodes_of_blocks<dim>(g.n_cells, block_cells, std::move(holding));
+
+      const long                n_nodes = static_cast<long>(active.lattice_of_node.size());
+      std::vector<std::uint8_t> node_fixed(n_nodes), node_friction(friction.empty() ? 0 : n_nodes);
+      for (long node = 0; node < n_nodes; ++node)
+        {
+          node_fixed[node] = fixed[active.lattice_of_node[node]];
+          if (!friction.empty())
+            node_friction[node] = friction[active.lattice_of_node[node]];
+        }
+      impl->grid.set_nodes(active.lattice_to_node, node_fixed, node_friction);
+      impl->node_offset        = 0;
+      impl->lattice_to_node    = std::move(active.lattice_to_node);
+      impl->lattice_of_node    = std::move(active.lattice_of_node);
+      impl->cell_sums_at_nodes = true;
+      if (impl->cell_volume.size() > 0)
+        {
+          impl->cell_volume.resize(n_nodes);
+          impl->cell_pressure_volume.resize(n_nodes);
+        }
+      return static_cast<int>(n_nodes);
+    }
+
+    template <int dim>
+    void DeviceEngine<dim>::download_kept_nodes(HostGrid<dim, double> &nodes, std::vector<long> &lattice_of_node) const
+    {
+      impl->backend.synchronize();
+      const DeviceGrid<dim, double> &dg = impl->grid;
+      nodes.h                           = dg.h;
+      for (int d = 0; d < dim; ++d)
+        {
+          nodes.origin[d]  = dg.origin[d];
+          nodes.n_cells[d] = dg.n_cells[d];
+        }
+      nodes.lattice_to_node = impl->lattice_to_node;
+      lattice_of_node       = impl->lattice_of_node;
+      dg.mass.download(nodes.mass);
+      for (int d = 0; d < dim; ++d)
+        dg.velocity[d].download(nodes.velocity[d]);
     }
 
     template class DeviceEngine<2>;

@@ -33,21 +33,112 @@ namespace mpm
     std::vector<long> lattice_of_node; // active node -> lattice node index
   };
 
+  // Blocks of block_cells^dim cells along each axis of a lattice of n_cells cells.
+  template <int dim>
+  MPM_HOST_DEVICE inline long n_blocks_along(const int n_cells, const int block_cells)
+  {
+    return (n_cells + block_cells - 1) / block_cells;
+  }
+
+  // The block of lattice cell `cell` (i + n_x (j + n_y k)), numbered the same way over blocks.
+  template <int dim>
+  MPM_HOST_DEVICE inline long block_of_cell(long cell, const int n_cells[dim], const int block_cells)
+  {
+    long block = 0, stride = 1;
+    for (int d = 0; d < dim; ++d)
+      {
+        block += (cell % n_cells[d]) / block_cells * stride;
+        cell /= n_cells[d];
+        stride *= n_blocks_along<dim>(n_cells[d], block_cells);
+      }
+    return block;
+  }
+
+  template <int dim>
+  long n_blocks(const int n_cells[dim], const int block_cells)
+  {
+    long n = 1;
+    for (int d = 0; d < dim; ++d)
+      n *= n_blocks_along<dim>(n_cells[d], block_cells);
+    return n;
+  }
+
+  // The active nodes from the blocks that hold a point's cell (holding[b] != 0, one entry per
+  // block): those blocks and their neighbours are kept, and the vertices of their cells.
+  template <int dim>
+  ActiveNodes nodes_of_blocks(const int n_cells[dim], const int block_cells, std::vector<std::uint8_t> holding)
+  {
+    long n_block[dim], total_blocks = 1, n_lattice_nodes = 1, node_stride[dim];
+    for (int d = 0; d < dim; ++d)
+      {
+        n_block[d]     = n_blocks_along<dim>(n_cells[d], block_cells);
+        node_stride[d] = n_lattice_nodes;
+        total_blocks *= n_block[d];
+        n_lattice_nodes *= n_cells[d] + 1;
+      }
+    // The neighbours: the mask dilated by one block along each axis in turn.
+    long stride = 1;
+    for (int d = 0; d < dim; ++d)
+      {
+        std::vector<std::uint8_t> grown(holding);
+        for (long b = 0; b < total_blocks; ++b)
+          {
+            const long i = b / stride % n_block[d];
+            if ((i > 0 && holding[b - stride]) || (i + 1 < n_block[d] && holding[b + stride]))
+              grown[b] = 1;
+          }
+        holding.swap(grown);
+        stride *= n_block[d];
+      }
+    // The vertices of a kept block's cells: lattice nodes B b .. B (b + 1) along each axis
+    // (clipped to the lattice), marked, then numbered in lattice order.
+    std::vector<std::uint8_t> kept(n_lattice_nodes, 0);
+    for (long b = 0; b < total_blocks; ++b)
+      {
+        if (!holding[b])
+          continue;
+        int  lower[dim], upper[dim], idx[dim];
+        long rest = b;
+        for (int d = 0; d < dim; ++d)
+          {
+            const int i = static_cast<int>(rest % n_block[d]);
+            rest /= n_block[d];
+            lower[d] = i * block_cells;
+            upper[d] = (i + 1) * block_cells < n_cells[d] ? (i + 1) * block_cells : n_cells[d];
+            idx[d]   = lower[d];
+          }
+        for (bool more = true; more;)
+          {
+            long lattice = 0;
+            for (int d = 0; d < dim; ++d)
+              lattice += idx[d] * node_stride[d];
+            kept[lattice] = 1;
+            more          = false;
+            for (int d = 0; d < dim && !more; ++d) // the next node of the block
+              if (++idx[d] <= upper[d])
+                more = true;
+              else
+                idx[d] = lower[d];
+          }
+      }
+    ActiveNodes nodes;
+    nodes.lattice_to_node.assign(n_lattice_nodes, -1);
+    for (long l = 0; l < n_lattice_nodes; ++l)
+      if (kept[l])
+        {
+          nodes.lattice_to_node[l] = static_cast<int>(nodes.lattice_of_node.size());
+          nodes.lattice_of_node.push_back(l);
+        }
+    return nodes;
+  }
+
   // The active nodes for the points p (those not removed), blocks of block_cells^dim cells.
   // home_cells, where given, receives every point's lattice cell (as GridView::lattice_cell).
   template <int dim, typename Real>
   ActiveNodes nodes_near_points(const Real origin[dim], const Real h, const int n_cells[dim], const int block_cells,
                                 const PointsView<dim, Real> &p, std::vector<long> *home_cells = nullptr)
   {
-    int  n_blocks[dim];
-    long total_blocks = 1;
-    for (int d = 0; d < dim; ++d)
-      {
-        n_blocks[d] = (n_cells[d] + block_cells - 1) / block_cells;
-        total_blocks *= n_blocks[d];
-      }
-    // Blocks holding a point's cell.
-    std::vector<std::uint8_t> active(total_blocks, 0);
+    std::vector<std::uint8_t> holding(n_blocks<dim>(n_cells, block_cells), 0);
     if (home_cells != nullptr)
       home_cells->assign(p.n_points, 0);
     for (int i = 0; i < p.n_points; ++i)
@@ -55,75 +146,12 @@ namespace mpm
         Real x[dim];
         for (int d = 0; d < dim; ++d)
           x[d] = p.position[d][i];
-        long cell = lattice_cell_containing<dim>(origin, h, n_cells, x);
+        const long cell = lattice_cell_containing<dim>(origin, h, n_cells, x);
         if (home_cells != nullptr)
           (*home_cells)[i] = cell;
-        if (p.material[i] < 0)
-          continue;
-        long block = 0, stride = 1;
-        for (int d = 0; d < dim; ++d)
-          {
-            block += (cell % n_cells[d]) / block_cells * stride;
-            cell /= n_cells[d];
-            stride *= n_blocks[d];
-          }
-        active[block] = 1;
+        if (p.material[i] >= 0)
+          holding[block_of_cell<dim>(cell, n_cells, block_cells)] = 1;
       }
-    // Their neighbours: the mask dilated by one block along each axis in turn.
-    long stride = 1;
-    for (int d = 0; d < dim; ++d)
-      {
-        std::vector<std::uint8_t> grown(active);
-        for (long b = 0; b < total_blocks; ++b)
-          {
-            const long i = b / stride % n_blocks[d];
-            if (i > 0 && active[b - stride])
-              grown[b] = 1;
-            if (i + 1 < n_blocks[d] && active[b + stride])
-              grown[b] = 1;
-          }
-        active.swap(grown);
-        stride *= n_blocks[d];
-      }
-    // A node is active where one of its cells is: node i along an axis touches cells i - 1
-    // and i (those inside the lattice), which lie in blocks first_block[i] .. last_block[i].
-    std::vector<int> first_block[dim], last_block[dim];
-    long             n_lattice_nodes = 1;
-    for (int d = 0; d < dim; ++d)
-      {
-        first_block[d].resize(n_cells[d] + 1);
-        last_block[d].resize(n_cells[d] + 1);
-        for (int i = 0; i <= n_cells[d]; ++i)
-          {
-            first_block[d][i] = (i > 0 ? i - 1 : 0) / block_cells;
-            last_block[d][i]  = (i < n_cells[d] ? i : n_cells[d] - 1) / block_cells;
-          }
-        n_lattice_nodes *= n_cells[d] + 1;
-      }
-    ActiveNodes nodes;
-    nodes.lattice_to_node.assign(n_lattice_nodes, -1);
-    int idx[dim] = {};
-    for (long l = 0; l < n_lattice_nodes; ++l)
-      {
-        bool is_active = false;
-        for (int corner = 0; corner < (1 << dim) && !is_active; ++corner)
-          {
-            long block = 0, block_stride = 1;
-            for (int d = 0; d < dim; ++d)
-              {
-                block += ((corner >> d) & 1 ? last_block[d][idx[d]] : first_block[d][idx[d]]) * block_stride;
-                block_stride *= n_blocks[d];
-              }
-            is_active = active[block] != 0;
-          }
-        if (is_active)
-          {
-            nodes.lattice_to_node[l] = static_cast<int>(nodes.lattice_of_node.size());
-            nodes.lattice_of_node.push_back(l);
-          }
-        for (int d = 0; d < dim && ++idx[d] > n_cells[d]; ++d) // the next lattice node
-          idx[d] = 0;
-      }
-    return nodes;
+    return nodes_of_blocks<dim>(n_cells, block_cells, std::move(holding));
   }
 } // namespace mpm

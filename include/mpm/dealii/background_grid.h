@@ -36,9 +36,11 @@ namespace mpm
   // The nodes of that lattice as an engine on one rank keeps them: every lattice node,
   // numbered in lattice order (x fastest), nodal arrays zero, and the boundary masks of
   // Boundary/* as BackgroundGrid sets them from the faces' boundary ids. It needs no
-  // deal.II grid, so one-rank runs start stepping while deal.II builds it.
+  // deal.II grid, so one-rank runs start stepping while deal.II builds it. Without
+  // nodal_arrays only the geometry and the masks (an engine that keeps only the nodes near
+  // the material fills its own).
   template <int dim>
-  HostGrid<dim, double> lattice_grid(const Parameters &parameters);
+  HostGrid<dim, double> lattice_grid(const Parameters &parameters, bool nodal_arrays = true);
 
   template <int dim>
   class BackgroundGrid

@@ -23,11 +23,12 @@ namespace mpm
   // Both throw naming Backend/Backend where this build has no CUDA engine (configured
   // without -DMPM_WITH_CUDA=ON) or where no CUDA device is found (on any rank).
 
-  // One rank: the device keeps the lattice's nodes (lattice_grid) in lattice order.
+  // One rank: the device keeps the lattice's nodes (lattice_grid) in lattice order, or,
+  // with active_block_cells > 0, those near the points (Grid/Nodes = near material).
   template <int dim>
   std::unique_ptr<Engine<dim>> make_cuda_engine(const HostGrid<dim, double> &lattice,
                                                 const std::vector<MaterialParameters<double>> &materials,
-                                                ShapeFunction shape);
+                                                ShapeFunction shape, int active_block_cells = 0);
 
   // Several ranks, one GPU each (ranks of a node beyond its GPUs share them): the device
   // keeps the rank's locally relevant nodes in the grid's numbering; after each P2G pass

@@ -182,6 +182,31 @@ namespace mpm
         friction_coefficient[f] = g.friction_coefficient[f];
     }
 
+    // New nodes: n_nodes = fixed.size(), reached through `lookup` (lattice node -> node),
+    // with those masks (friction empty: no frictional face) and every nodal value zero; the
+    // geometry stays. The memory held only grows.
+    void set_nodes(const std::vector<int> &lookup, const std::vector<std::uint8_t> &fixed,
+                   const std::vector<std::uint8_t> &friction)
+    {
+      const size_t n = fixed.size();
+      mass.resize(n);
+      for (int d = 0; d < dim; ++d)
+        {
+          momentum[d].resize(n);
+          force[d].resize(n);
+          velocity[d].resize(n);
+          momentum[d].fill_bytes(0);
+          force[d].fill_bytes(0);
+          velocity[d].fill_bytes(0);
+        }
+      mass.fill_bytes(0);
+      lattice_order = false;
+      node_offset   = 0;
+      lattice_to_node.upload(lookup);
+      fixed_components.upload(fixed);
+      friction_faces.upload(friction);
+    }
+
     // Nodal values back to the host (tests, output).
     void download_nodal(HostGrid<dim, Real> &g) const
     {
