@@ -9,7 +9,6 @@
 #include <deal.II/base/parallel.h>
 
 #ifdef MPM_CUDA_ENGINE
-#  include <mpm/core/active_nodes.h>
 #  include <mpm/cuda/device_engine.h>
 
 #  if __has_include(<mpi-ext.h>)
@@ -91,43 +90,32 @@ namespace mpm
                  const ShapeFunction shape, const int active_block_cells)
         : materials(materials)
         , shape(shape)
-        , active_block_cells(active_block_cells)
       {
         GridView<dim, double> view = make_grid_view<dim, double>(lattice);
         if (active_block_cells > 0) // no node until the points are loaded
           {
-            lattice_fixed_components = lattice.fixed_components;
-            lattice_friction_faces   = lattice.friction_faces;
+            this->near_material.block_cells              = active_block_cells;
+            this->near_material.shape                    = shape;
+            this->near_material.lattice_fixed_components = lattice.fixed_components;
+            this->near_material.lattice_friction_faces   = lattice.friction_faces;
             view.lattice_to_node     = nullptr;
             view.n_nodes             = 0; // (the friction coefficients are taken, the masks later)
           }
         device = std::make_unique<cuda::DeviceEngine<dim>>(view, materials, shape, nullptr);
       }
 
-      bool follows_material() const override { return active_block_cells > 0; }
-
-      double active_node_margin() const override
-      {
-        return follows_material() ? mpm::active_node_margin(shape, active_block_cells) : 0;
-      }
-
       void refresh_active_nodes() override
       {
-        if (!follows_material())
-          return;
-        const long n = device->keep_nodes_near_points(active_block_cells, lattice_fixed_components,
-                                                      lattice_friction_faces);
-        most_active_nodes = std::max(most_active_nodes, n);
-        active_nodes      = n;
+        auto &near = this->near_material;
+        if (this->follows_material())
+          near.kept(device->keep_nodes_near_points(near.block_cells, near.lattice_fixed_components,
+                                                   near.lattice_friction_faces));
       }
-
-      long n_active_nodes() const override { return active_nodes; }
-
-      long most_nodes() const override { return most_active_nodes; }
 
       void cells_with_mass(typename GridSnapshot<dim>::LatticeCells &out) override
       {
-        AssertThrow(follows_material(), dealii::ExcMessage("Internal: cells_with_mass() needs Nodes = near material."));
+        AssertThrow(this->follows_material(),
+                    dealii::ExcMessage("Internal: cells_with_mass() needs Nodes = near material."));
         HostGrid<dim, double> nodes;
         std::vector<long>     lattice_of_node;
         device->download_kept_nodes(nodes, lattice_of_node);
@@ -303,7 +291,7 @@ namespace mpm
 
       double max_distance_outside_home_cells() override
       {
-        AssertThrow(shared_grid != nullptr || follows_material(),
+        AssertThrow(shared_grid != nullptr || this->follows_material(),
                     dealii::ExcMessage("Internal: the home cells are known only for points loaded from the "
                                        "ParticleHandler or where the nodes follow the points."));
         return device->max_distance_outside_home_cells();
@@ -325,11 +313,6 @@ namespace mpm
       BackgroundGrid<dim>                    *shared_grid = nullptr;
       std::vector<MaterialParameters<double>> materials; // the latest table, for a rebuild
       ShapeFunction                           shape;
-      // One rank, nodes near the points: the block size (0: every node), the whole
-      // lattice's boundary masks, the nodes kept now and the most kept.
-      int                       active_block_cells = 0;
-      std::vector<std::uint8_t> lattice_fixed_components, lattice_friction_faces;
-      long                      active_nodes = 0, most_active_nodes = 0;
       int                                     sort_interval = -1; // -1: the device's default
       // The partition the device's nodes were built for (kept alive, so a new one cannot
       // reuse its address).

@@ -1,4 +1,3 @@
-#include <mpm/core/active_nodes.h>
 #include <mpm/core/backend/cpu_backend.h>
 #include <mpm/core/migration.h>
 #include <mpm/dealii/cuda_engine.h>
@@ -21,8 +20,7 @@ namespace mpm
       // by refresh_active_nodes(); the lattice's boundary masks are kept to fill them.
       CpuEngine(const HostGrid<dim, double> &lattice, const std::vector<MaterialParameters<double>> &materials,
                 const ShapeFunction shape, const int active_block_cells)
-        : active_block_cells(active_block_cells)
-        , materials(materials)
+        : materials(materials)
         , shape(shape)
       {
         if (active_block_cells == 0)
@@ -31,6 +29,10 @@ namespace mpm
             own_nodes.allocate_cells();
             return;
           }
+        this->near_material.block_cells              = active_block_cells;
+        this->near_material.shape                    = shape;
+        this->near_material.lattice_fixed_components = lattice.fixed_components;
+        this->near_material.lattice_friction_faces   = lattice.friction_faces;
         own_nodes.h = lattice.h;
         for (int d = 0; d < dim; ++d)
           {
@@ -39,8 +41,6 @@ namespace mpm
           }
         for (int f = 0; f < 2 * dim; ++f)
           own_nodes.friction_coefficient[f] = lattice.friction_coefficient[f];
-        lattice_fixed_components = lattice.fixed_components;
-        lattice_friction_faces   = lattice.friction_faces;
       }
 
       // Several ranks: the grid's vectors are the nodal arrays, summed over ranks.
@@ -67,7 +67,7 @@ namespace mpm
         // New points: the scatter's slabs are built anew for them, as in a new engine (a
         // run resumed from a checkpoint then sums in the order of the run that wrote it).
         backend.forget_grouping();
-        if (follows_material())
+        if (this->follows_material())
           refresh_active_nodes();
       }
 
@@ -77,50 +77,41 @@ namespace mpm
         home_cells.clear(); // asked for on several ranks (loaded from the handler) and below
         labels = std::move(new_labels);
         backend.forget_grouping();
-        if (follows_material())
+        if (this->follows_material())
           refresh_active_nodes();
-      }
-
-      bool follows_material() const override { return active_block_cells > 0; }
-
-      double active_node_margin() const override
-      {
-        return follows_material() ? mpm::active_node_margin(shape, active_block_cells) : 0;
       }
 
       // The nodes near the points as they are now; their nodal sums start from zero, as
       // every step's do. Every point's home cell becomes its current cell.
       void refresh_active_nodes() override
       {
-        if (!follows_material())
+        if (!this->follows_material())
           return;
-        ActiveNodes active = nodes_near_points<dim>(own_nodes.origin, own_nodes.h, own_nodes.n_cells,
-                                                    active_block_cells, points.view(), &home_cells);
+        const auto &near   = this->near_material;
+        ActiveNodes active = nodes_near_points<dim>(own_nodes.origin, own_nodes.h, own_nodes.n_cells, near.block_cells,
+                                                    points.view(), &home_cells);
         own_nodes.lattice_to_node = std::move(active.lattice_to_node);
         lattice_of_node           = std::move(active.lattice_of_node);
         const long n              = static_cast<long>(lattice_of_node.size());
         own_nodes.allocate_nodes(static_cast<int>(n));
-        own_nodes.friction_faces.assign(lattice_friction_faces.empty() ? 0 : n, 0);
+        own_nodes.friction_faces.assign(near.lattice_friction_faces.empty() ? 0 : n, 0);
         for (long node = 0; node < n; ++node)
           {
-            own_nodes.fixed_components[node] = lattice_fixed_components[lattice_of_node[node]];
-            if (!lattice_friction_faces.empty())
-              own_nodes.friction_faces[node] = lattice_friction_faces[lattice_of_node[node]];
+            own_nodes.fixed_components[node] = near.lattice_fixed_components[lattice_of_node[node]];
+            if (!near.lattice_friction_faces.empty())
+              own_nodes.friction_faces[node] = near.lattice_friction_faces[lattice_of_node[node]];
           }
         own_nodes.cell_volume.assign(n, 0.0); // the cells' sums at their lowest vertex
         own_nodes.cell_pressure_volume.assign(n, 0.0);
-        most_active_nodes = std::max(most_active_nodes, n);
+        this->near_material.kept(n);
       }
 
       void cells_with_mass(typename GridSnapshot<dim>::LatticeCells &out) override
       {
-        AssertThrow(follows_material(), dealii::ExcMessage("Internal: cells_with_mass() needs Nodes = near material."));
+        AssertThrow(this->follows_material(),
+                    dealii::ExcMessage("Internal: cells_with_mass() needs Nodes = near material."));
         out = lattice_cells_with_mass(own_nodes, lattice_of_node);
       }
-
-      long n_active_nodes() const override { return static_cast<long>(own_nodes.mass.size()); }
-
-      long most_nodes() const override { return most_active_nodes; }
 
       unsigned int store(MaterialPoints<dim> &p) override
       {
@@ -142,7 +133,7 @@ namespace mpm
           return;
         const GridView<dim, double> to = grid.view();
         const long                  n  = static_cast<long>(own_nodes.mass.size());
-        if (follows_material()) // the others are zero (no mass, no velocity)
+        if (this->follows_material()) // the others are zero (no mass, no velocity)
           {
             std::fill(to.mass, to.mass + to.n_nodes, 0.0);
             for (int d = 0; d < dim; ++d)
@@ -150,7 +141,7 @@ namespace mpm
           }
         for (long l = 0; l < n; ++l)
           {
-            const int node = to.lattice_to_node[follows_material() ? lattice_of_node[l] : l];
+            const int node = to.lattice_to_node[this->follows_material() ? lattice_of_node[l] : l];
             to.mass[node]  = own_nodes.mass[l];
             for (int d = 0; d < dim; ++d)
               to.velocity[d][node] = own_nodes.velocity[d][l];
@@ -180,7 +171,7 @@ namespace mpm
         if (shared_grid == nullptr)
           {
             GridView<dim, double> g = make_grid_view<dim, double>(own_nodes);
-            if (follows_material())
+            if (this->follows_material())
               g.cell_sums_at_nodes = true;
             else
               g.lattice_to_node = nullptr; // lattice order: a node's index is its lattice index
@@ -203,12 +194,7 @@ namespace mpm
       // the cell sums; the nodes are shared_grid's vectors.
       HostGrid<dim, double>                   own_nodes;
       BackgroundGrid<dim>                    *shared_grid = nullptr;
-      // Nodes near the material only (one rank): the block size in cells (0: every node),
-      // the lattice index of each active node, the whole lattice's boundary masks.
-      int                       active_block_cells = 0;
-      std::vector<long>         lattice_of_node;
-      std::vector<std::uint8_t> lattice_fixed_components, lattice_friction_faces;
-      long                      most_active_nodes = 0;
+      std::vector<long> lattice_of_node; // nodes near the material: the lattice index of each
       std::vector<MaterialParameters<double>> materials;
       ShapeFunction                           shape;
       CpuBackend                              backend;

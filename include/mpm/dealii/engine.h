@@ -10,6 +10,7 @@
 // (cuda_engine.h) implements the same interface over device arrays, one GPU per rank.
 #pragma once
 
+#include <mpm/core/active_nodes.h>
 #include <mpm/core/diagnostics.h>
 #include <mpm/core/step.h>
 #include <mpm/dealii/material_points.h>
@@ -71,20 +72,40 @@ namespace mpm
     // (active_nodes.h). The run refreshes them (refresh_active_nodes) before a point gets
     // active_node_margin() cells out of the cell it was in at the last refresh; loading
     // points refreshes them too.
-    virtual bool   follows_material() const { return false; }
-    virtual double active_node_margin() const { return 0; }
-    virtual void   refresh_active_nodes() {}
+    bool   follows_material() const { return near_material.block_cells > 0; }
+    double active_node_margin() const
+    {
+      return follows_material() ? mpm::active_node_margin(near_material.shape, near_material.block_cells) : 0;
+    }
+    virtual void refresh_active_nodes() {}
     // For the grid output without deal.II's grid (one rank, nodes near the material): the
     // lattice cells with mass at a vertex, in lattice order, with their vertices' fields.
     virtual void cells_with_mass(typename GridSnapshot<dim>::LatticeCells & /*cells*/)
     {
       AssertThrow(false, dealii::ExcMessage("Internal: this engine keeps no nodes of its own to write."));
     }
-    // Nodes the engine updates now, and the most it has had.
-    virtual long n_active_nodes() const { return 0; }
-    virtual long most_nodes() const { return 0; }
+    // Nodes the engine updates now, and the most it has had (nodes near the material).
+    long n_active_nodes() const { return near_material.now; }
+    long most_nodes() const { return near_material.most; }
     // Replaces the material table (e.g. when plasticity is switched on).
     virtual void set_materials(const std::vector<MaterialParameters<double>> &materials) = 0;
+
+  protected:
+    // One rank, nodes near the material: what the engine keeps between its choices of nodes.
+    struct NearMaterialNodes
+    {
+      int                       block_cells = 0; // 0: every node
+      ShapeFunction             shape       = ShapeFunction::gimp;
+      std::vector<std::uint8_t> lattice_fixed_components, lattice_friction_faces; // of the whole lattice
+      long                      now = 0, most = 0;                                 // nodes kept
+
+      void kept(const long n)
+      {
+        now  = n;
+        most = n > most ? n : most;
+      }
+    };
+    NearMaterialNodes near_material;
   };
 
   // Throws naming Backend/Backend where the backend is not in this build. The simulator
