@@ -378,6 +378,13 @@ namespace mpm
           const double distance = distance_outside_home_cells(dt, when);
           const auto   checked  = clock::now();
           loop_times.home_check += std::chrono::duration<double>(checked - stepped).count();
+          AssertThrow(!parameters.pressure_averaging || distance < parameters.active_block_cells,
+                      dealii::ExcMessage("Parameter 'Solver/Pressure averaging': " + when() + " a point moved " +
+                                         dealii::Utilities::to_string(distance) +
+                                         " cells out of the cell it was in when the nodes near the material were "
+                                         "chosen, beyond the kept cells whose pressure sums the step used (Grid/"
+                                         "Active block size = " + std::to_string(parameters.active_block_cells) +
+                                         "). Reduce 'Solver/CFL number' or the time step, or enlarge the blocks."));
           if (distance >= resort_at)
             {
               engine->refresh_active_nodes();
@@ -710,8 +717,15 @@ namespace mpm
     // asserts it.
     void set_resort_distance()
     {
+      // One rank, nodes near the material: every cell within Active block size cells of a
+      // point's home cell is kept. The pressure averaging sums over the cells the points
+      // have moved to within the step (less than a cell, CFL <= 1): choosing the nodes again
+      // once a point is B - 1 cells out keeps those cells' sums.
       if (!parallel)
-        resort_at = engine->follows_material() ? engine->active_node_margin() : 1e300;
+        resort_at = !engine->follows_material() ? 1e300 :
+                    parameters.pressure_averaging ?
+                                                  std::min(engine->active_node_margin(), parameters.active_block_cells - 1.0) :
+                                                  engine->active_node_margin();
       else
         resort_at = std::min(parameters.resort_distance * safe_distance_outside_home_cell(parameters.shape_function),
                              parameters.pressure_averaging ? 0.5 : 1e300);

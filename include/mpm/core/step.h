@@ -220,6 +220,8 @@ namespace mpm
     {
       const Real mean = mean_normal_stress(s_xx, s_yy, s_zz);
       const int  c    = g.cell_sum_entry(x);
+      if (c < 0) // a cell whose sums are not kept (nodes near the material: the run stops after the step)
+        return Real(0);
       return g.cell_pressure_volume[c] / g.cell_volume[c] - mean;
     }
 
@@ -603,6 +605,8 @@ namespace mpm
     {
       Real        mean;
       const int   c          = cell_and_mean_stress(g, p, i, mean);
+      if (c < 0) // a cell whose sums are not kept (nodes near the material: the run stops after the step)
+        return;
       const Real  V          = p.volume[i];
       Real *const targets[2] = {g.cell_volume, g.cell_pressure_volume};
       const Real  values[2]  = {V, V * mean};

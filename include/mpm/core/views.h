@@ -80,7 +80,8 @@ namespace mpm
     MPM_HOST_DEVICE int n_lattice_nodes(const int d) const { return n_cells[d] + 1; }
 
     // Entry of the pressure averaging's sums for the cell containing x (clamped like
-    // lattice_cell): the lattice cell, or its lowest vertex's node (cell_sums_at_nodes).
+    // lattice_cell): the lattice cell, or its lowest vertex's node (cell_sums_at_nodes; -1
+    // where that node is not kept).
     MPM_HOST_DEVICE int cell_sum_entry(const Real x[dim]) const
     {
       if (!cell_sums_at_nodes)
