@@ -7,13 +7,13 @@ precision, backend, machine, date. Draws per scene the Pareto chart (error again
 log-log, one marker per method, the front of runs no other run beats in both) and, for V1, the
 convergence plot. doc/methods.md ("The study") gives the results.
 
-  study.py --exe build/dealii-mpm --out DIR [--scenes v1,v2,v3] [--methods a,b] [--reduced]
-           [--csv FILE] [--figures DIR] [--check]
+  study.py --exe build/dealii-mpm --out DIR [--scenes v1,v2,v3,mms] [--methods a,b] [--reduced]
+           [--csv FILE] [--figures DIR] [--check] [--mms-exe build/tests/core/mms_study]
 
 --reduced: the coarse levels only (the ctest); --check: assert that every run is stable and its error
 within the scene's bound (not the times), exit 1 if one is not. The bounds are what a usable method
 reaches at the reduced levels: V1 2e-2 (16 and 32 cells), V2 5% (h = 0.25 m), V3 0.25 (h = 10 mm,
-where the FLIP-blend methods' toes are 15-25% short). Linear shapes, pure FLIP and PIC are not held to
+where the FLIP-blend methods' toes are 15-25% short), MMS 0.1 (16 and 32 cells). Linear shapes, pure FLIP and PIC are not held to
 them (the stability matrix shows where the first two fail; PIC's dissipation stops the V2 beam's swing
 and shortens V3's toe by 40%).
 
@@ -23,6 +23,10 @@ Errors:
       reference being our own h = 0.0625 m run with cpGIMP U (doc/methods.md).
   v3  V3 collapse (tests/prm/collapse_v3_coarse_2d.prm at h): r.m.s. of the relative errors of toe,
       top-left height and surface slope against the experiment's 0.435 m, 0.099 m and 14 deg.
+  mms the manufactured solution of tests/core/manufactured_solution.h (the unit square stretched
+      along its axes by +-31% over a period, kept exact by a body force), run by the core program
+      mms_study (CPU backend, no deal.II): the largest over the steps of the volume-weighted L2 error
+      of the positions, / the amplitude. Its wall time is the steps' alone (no set-up, no output).
 """
 import argparse
 import csv
@@ -52,6 +56,7 @@ METHODS = {
     "cpgimp_f_ii": ("cpGIMP F_ii, FLIP 0.99", shape("GIMP", "F_ii") + ["set FLIP fraction = 0.99"], []),
     "cpgimp_u": ("cpGIMP U, FLIP 0.99", shape("GIMP", "U") + ["set FLIP fraction = 0.99"], []),
     "bspline2": ("B-spline 2, FLIP 0.99", shape("quadratic B-spline") + ["set FLIP fraction = 0.99"], []),
+    "bspline3": ("B-spline 3, FLIP 0.99", shape("cubic B-spline") + ["set FLIP fraction = 0.99"], []),
     "gimp_pic": ("uGIMP, PIC", shape("GIMP") + ["set FLIP fraction = 0"], []),
     "gimp_flip": ("uGIMP, pure FLIP", shape("GIMP") + ["set FLIP fraction = 1"], []),
     "bspline2_pic": ("B-spline 2, PIC", shape("quadratic B-spline") + ["set FLIP fraction = 0"], []),
@@ -103,13 +108,33 @@ SCENES = {
     "v3": ("tests/prm/collapse_v3_coarse_2d.prm", "aluminium bars",
            [(h, ["subsection Grid", f"  set Cell size = {h:g}", "end"]) for h in (0.01, 0.005, 0.0025)], (0.01,), [],
            v3_error, 0.25),
+    # run by mms_study (run_mms), not by dealii-mpm: h = 1 / cells
+    "mms": (None, None, [(1.0 / n, []) for n in (8, 16, 32, 64, 128)], (1.0 / 16, 1.0 / 32), [], None, 0.1),
 }
 
 COLUMNS = ["scene", "method", "h", "points", "steps", "wall_s", "point_updates_per_s", "error", "stable",
            "precision", "backend", "machine", "date", "details"]
 
 
-def run_one(exe, out_root, scene, method, h, overrides):
+def run_mms(mms_exe, method, h):
+    cells = int(round(1.0 / h))
+    done = subprocess.run([mms_exe, "--methods", method, "--cells", str(cells)], capture_output=True, text=True)
+    row = {"scene": "mms", "method": method, "h": h, "precision": "FP64", "backend": "cpu",
+           "machine": mpm_runs.machine(), "date": mpm_runs.today()}
+    if done.returncode != 0:
+        row.update(points="", steps="", wall_s=float("nan"), point_updates_per_s="", error="", stable="no",
+                   details=done.stderr.strip()[:200])
+        return row
+    r = list(csv.DictReader(done.stdout.splitlines()))[0]
+    row.update(points=int(r["points"]), steps=int(r["steps"]), wall_s=float(r["wall_s"]),
+               point_updates_per_s=float(r["point_updates_per_s"]), error=float(r["displacement_error"]),
+               stable=r["stable"], details=f"stress_error={float(r['stress_error']):.5g}")
+    return row
+
+
+def run_one(exe, out_root, scene, method, h, overrides, mms_exe=None):
+    if scene == "mms":
+        return run_mms(mms_exe, method, h)
     prm, material, _, _, solver, error_of, _ = SCENES[scene]
     label, method_solver, method_other = METHODS[method]
     other = [f"subsection Material {material}" if x == "@material" else x for x in method_other]
@@ -167,21 +192,25 @@ def draw(rows, figures):
         fig.tight_layout()
         fig.savefig(os.path.join(figures, f"study_{scene}_pareto.png"), dpi=110)
         plt.close(fig)
-    v1 = [r for r in rows if r["scene"] == "v1" and r["stable"] == "yes"]
-    if v1:
+    for scene, what, title in (("v1", "V1 error norm", "V1 column"),
+                               ("mms", "MMS position error / amplitude", "Manufactured solution")):
+        mine = [r for r in rows if r["scene"] == scene and r["stable"] == "yes"]
+        if not mine:
+            continue
         fig, ax = plt.subplots(figsize=(7, 5))
         for k, method in enumerate(METHODS):
-            pts = sorted((float(r["h"]), float(r["error"])) for r in v1 if r["method"] == method)
+            pts = sorted((float(r["h"]), float(r["error"])) for r in mine if r["method"] == method)
             if pts:
                 ax.loglog(*zip(*pts), "-" + markers[k % len(markers)], label=METHODS[method][0])
-        h = np.array(sorted({float(r["h"]) for r in v1}))
-        ax.loglog(h, 3e-3 * (h / h[len(h) // 2]) ** 2, "k:", label="order 2")
+        h = np.array(sorted({float(r["h"]) for r in mine}))
+        middle = [float(r["error"]) for r in mine if float(r["h"]) == h[len(h) // 2]]
+        ax.loglog(h, min(middle) * (h / h[len(h) // 2]) ** 2, "k:", label="order 2")
         ax.set_xlabel("cell size h (m)")
-        ax.set_ylabel("V1 error norm")
-        ax.set_title("V1 column: convergence", fontsize=9)
+        ax.set_ylabel(what)
+        ax.set_title(f"{title}: convergence", fontsize=9)
         ax.legend(fontsize=7)
         fig.tight_layout()
-        fig.savefig(os.path.join(figures, "study_v1_convergence.png"), dpi=110)
+        fig.savefig(os.path.join(figures, f"study_{scene}_convergence.png"), dpi=110)
         plt.close(fig)
 
 
@@ -195,7 +224,9 @@ def main():
     ap.add_argument("--csv")
     ap.add_argument("--figures")
     ap.add_argument("--check", action="store_true")
+    ap.add_argument("--mms-exe", help="the core program mms_study (default: tests/core/mms_study beside --exe)")
     args = ap.parse_args()
+    mms_exe = args.mms_exe or os.path.join(os.path.dirname(os.path.abspath(args.exe)), "tests", "core", "mms_study")
     rows = []
     for scene in args.scenes.split(","):
         levels, reduced = SCENES[scene][2], SCENES[scene][3]
@@ -203,7 +234,7 @@ def main():
             for h, overrides in levels:
                 if args.reduced and not any(abs(h - r) < 1e-12 for r in reduced):
                     continue
-                row = run_one(args.exe, os.path.abspath(args.out), scene, method, h, overrides)
+                row = run_one(args.exe, os.path.abspath(args.out), scene, method, h, overrides, mms_exe)
                 rows.append(row)
                 print(f"{scene} {METHODS[method][0]:32s} h={h:<8.4g} error={row['error']!s:22.22s} "
                       f"wall={row['wall_s']:.2f}s stable={row['stable']} {row['details']}", flush=True)

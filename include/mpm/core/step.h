@@ -65,6 +65,11 @@ namespace mpm
     // 0. -1: no APIC. Host backends whose stages use HostStencil only (the CPU's; explicit_step
     // refuses the others).
     int affine_state_variable = -1;
+    // A body acceleration of each point's own, added to gravity in P2G: dim state variables
+    // from p.state_variables[body_force_state_variable] that the caller sets before each step
+    // (the manufactured solutions of tests/core/manufactured_solution.h). -1: none. Host
+    // backends (the state variables live on the host).
+    int body_force_state_variable = -1;
   };
 
   // Per-step reductions over the points: the next time step needs the largest speed,
@@ -335,6 +340,10 @@ namespace mpm
           {
             all.c_N[1 + d]       = m * v[d];
             all.c_N[1 + dim + d] = m * s.gravity[d];
+#ifndef __CUDA_ARCH__
+            if (s.body_force_state_variable >= 0)
+              all.c_N[1 + dim + d] += m * p.state_variables[s.body_force_state_variable + d][i];
+#endif
             for (int e = 0; e < dim; ++e)
               all.c_grad[d][e] = -V * sigma(d, e);
           }
@@ -906,6 +915,13 @@ namespace mpm
           throw std::invalid_argument("explicit_step: APIC needs flip_fraction = 0 (its velocity is PIC's)");
         if (p.n_state_variables < s.affine_state_variable + dim * dim)
           throw std::invalid_argument("explicit_step: APIC's affine matrix needs dim x dim state variables");
+      }
+    if (s.body_force_state_variable >= 0)
+      {
+        if (atomic_scatter<Backend>::value)
+          throw std::invalid_argument("explicit_step: a point's own body force runs on host backends only");
+        if (p.n_state_variables < s.body_force_state_variable + dim)
+          throw std::invalid_argument("explicit_step: a point's own body force needs dim state variables");
       }
     // The arrays summed over ranks after each P2G (MPI): after the first, mass, momentum
     // and force in one exchange (one round of messages, and on the GPU one staging).
