@@ -39,8 +39,8 @@ METHODS = {
     "cpgimp_u": ("cpGIMP U", ["set Shape function = GIMP", "set GIMP domain update = U"]),
     "bspline2": ("quadratic B-spline", ["set Shape function = quadratic B-spline",
                                         "set GIMP domain update = none"]),
-    "ugimp_apic": ("uGIMP, APIC", ["set Shape function = GIMP", "set GIMP domain update = none",
-                                   "set Velocity transfer = APIC"]),
+    "ugimp_tpic": ("uGIMP, TPIC", ["set Shape function = GIMP", "set GIMP domain update = none",
+                                   "set Velocity transfer = TPIC"]),
     # Material entries: "@material" stands for each material of the scene's prm.
     "cpgimp_u_hencky": ("cpGIMP U, Hencky", ["set Shape function = GIMP", "set GIMP domain update = U"],
                         ["@material", "  set Elastic law = Hencky", "end"]),

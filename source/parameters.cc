@@ -182,12 +182,15 @@ namespace mpm
                       "at rest up to round-off is otherwise braked by D |f| in a direction that round-off picks.");
     prm.declare_entry("FLIP fraction", "1", Patterns::Double(0, 1),
                       "Velocity update: 1 = pure FLIP, 0 = pure PIC, in between a blend. Not used with "
-                      "Velocity transfer = APIC.");
-    prm.declare_entry("Velocity transfer", "FLIP/PIC blend", Patterns::Selection("FLIP/PIC blend|APIC"),
-                      "FLIP/PIC blend: the points' velocities by FLIP fraction. APIC (Jiang et al. 2015): each point "
-                      "also carries an affine velocity matrix C (output as the fields apic_C_xx, apic_C_xy, ...), "
-                      "its momentum reaches the grid as m N (v + C (x_i - x_p)) and the grid gives back PIC's "
-                      "velocity and C; conserves angular momentum in the transfers without FLIP's noise. CPU "
+                      "Velocity transfer = APIC or TPIC.");
+    prm.declare_entry("Velocity transfer", "FLIP/PIC blend", Patterns::Selection("FLIP/PIC blend|APIC|TPIC"),
+                      "FLIP/PIC blend: the points' velocities by FLIP fraction. APIC and TPIC: each point also "
+                      "carries an affine velocity matrix C (output as the fields apic_C_xx, apic_C_xy, ...), its "
+                      "momentum reaches the grid as m N (v + C (x_i - x_p)) and the grid gives back PIC's velocity "
+                      "and C; both keep angular momentum through the transfers without FLIP's noise. TPIC "
+                      "(Taylor PIC): C = sum_i v_i grad N_i, with any Shape function. APIC (Jiang et al. 2015): "
+                      "C = B D^-1 with the B-splines' constant D (h^2/4 quadratic, h^2/3 cubic), equal to TPIC's "
+                      "for linear; it needs Shape function = linear, quadratic B-spline or cubic B-spline. CPU "
                       "backend only for now. C starts at zero.");
     prm.declare_entry("Gravity", zeros(dim, -9.81), point_pattern(dim),
                       "Gravitational acceleration vector (m/s^2).");
@@ -492,7 +495,14 @@ namespace mpm
                                                                   : LocalDampingForm::per_component;
     damping_threshold = prm.get_double("Local damping threshold");
     flip_fraction     = prm.get_double("FLIP fraction");
-    apic              = prm.get("Velocity transfer") == "APIC";
+    const std::string transfer = prm.get("Velocity transfer");
+    apic                       = transfer == "APIC" || transfer == "TPIC";
+    affine_matrix = transfer == "APIC" ? AffineMatrix::b_d_inverse : AffineMatrix::velocity_gradient;
+    if (transfer == "APIC" && shape_function == ShapeFunction::gimp)
+      fail("Solver/Velocity transfer", "APIC needs Shape function = linear, quadratic B-spline or cubic B-spline "
+                                       "(its D_p is constant only for the B-splines; with GIMP a D_p computed per "
+                                       "point turns singular at the grid's faces); with Shape function = GIMP use "
+                                       "Velocity transfer = TPIC.");
     if (apic)
       flip_fraction = 0; // APIC's velocity is PIC's plus the affine part
     gravity           = get_point(prm, "Gravity", "Solver/");
@@ -775,8 +785,10 @@ namespace mpm
                                       material_models[i] + "' is defined outside the library and runs on the "
                                       "CPU backend only (Backend = cpu).");
           else if (apic)
-            fail("Backend/Backend", "cuda cannot run Solver/Velocity transfer = APIC: it runs on the CPU backend "
-                                    "only for now (Backend = cpu, or Velocity transfer = FLIP/PIC blend).");
+            fail("Backend/Backend", "cuda cannot run Solver/Velocity transfer = " +
+                                      std::string(affine_matrix == AffineMatrix::b_d_inverse ? "APIC" : "TPIC") +
+                                      ": it runs on the CPU backend only for now (Backend = cpu, or Velocity "
+                                      "transfer = FLIP/PIC blend).");
           else if (materials[i].elastic_law == ElasticLaw::hencky)
             fail("Backend/Backend", "cuda cannot run material '" + material_names[i] + "': its Elastic law = "
                                       "Hencky runs on the CPU backend only for now (Backend = cpu, or Material " +

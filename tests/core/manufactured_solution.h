@@ -120,11 +120,12 @@ namespace mpm_test
     MmsShape          shape;
     mpm::DomainUpdate domain_update = mpm::DomainUpdate::none;
     double            flip_fraction = 0.99;
-    bool              apic          = false;
+    bool              apic          = false; // an affine transfer, its matrix by `affine`
     mpm::ElasticLaw   law           = mpm::ElasticLaw::jaumann_rate;
+    mpm::AffineMatrix affine        = mpm::AffineMatrix::velocity_gradient;
   };
 
-  // The methods of scripts/study.py (same keys and settings), and the cubic B-spline.
+  // The methods of scripts/study.py (same keys and settings).
   inline std::vector<MmsMethod> mms_methods()
   {
     using mpm::DomainUpdate;
@@ -138,8 +139,10 @@ namespace mpm_test
             {"gimp_pic", MmsShape::gimp, DomainUpdate::none, 0},
             {"gimp_flip", MmsShape::gimp, DomainUpdate::none, 1},
             {"bspline2_pic", MmsShape::quadratic_bspline, DomainUpdate::none, 0},
-            {"gimp_apic", MmsShape::gimp, DomainUpdate::none, 0, true},
-            {"bspline2_apic", MmsShape::quadratic_bspline, DomainUpdate::none, 0, true},
+            {"gimp_tpic", MmsShape::gimp, DomainUpdate::none, 0, true},
+            {"bspline2_tpic", MmsShape::quadratic_bspline, DomainUpdate::none, 0, true},
+            {"bspline2_apic", MmsShape::quadratic_bspline, DomainUpdate::none, 0, true, mpm::ElasticLaw::jaumann_rate,
+             mpm::AffineMatrix::b_d_inverse},
             {"cpgimp_u_hencky", MmsShape::gimp, DomainUpdate::U, 0.99, false, mpm::ElasticLaw::hencky}};
   }
 
@@ -220,6 +223,7 @@ namespace mpm_test
     s.mass_tolerance            = 1e-12 * points.mass[0];
     s.body_force_state_variable = body_force;
     s.affine_state_variable     = method.apic ? affine : -1;
+    s.affine_matrix             = method.affine;
 
     double V0 = 0;
     for (int i = 0; i < n; ++i)

@@ -25,12 +25,13 @@ namespace mpm_test
     long   n_steps      = 0;
   };
 
-  // The velocity transfer: the FLIP/PIC blend (flip_fraction), or APIC (affine matrix in the
-  // points' first dim x dim state variables, flip_fraction 0).
+  // The velocity transfer: the FLIP/PIC blend (flip_fraction), or an affine transfer, TPIC or
+  // APIC by `affine` (affine matrix in the points' first dim x dim state variables, flip_fraction 0).
   struct Transfer
   {
-    double flip_fraction = 1;
-    bool   apic          = false;
+    double            flip_fraction = 1;
+    bool              apic          = false;
+    mpm::AffineMatrix affine        = mpm::AffineMatrix::velocity_gradient;
   };
 
   // Spins the block by `turn` radians at 2 rad/s; `points` receives the final state,
@@ -104,6 +105,7 @@ namespace mpm_test
     s.damping        = 0;
     s.flip_fraction  = transfer.apic ? 0 : transfer.flip_fraction;
     s.affine_state_variable = transfer.apic ? 0 : -1;
+    s.affine_matrix         = transfer.affine;
     s.domain_update  = update;
     s.mass_tolerance = 1e-12 * points.mass[0];
 

@@ -32,6 +32,15 @@ namespace mpm
     usf  = 2  // update stress first
   };
 
+  // The affine velocity matrix C_p of the affine transfers (StepSettings::affine_state_variable).
+  enum class AffineMatrix : int
+  {
+    velocity_gradient = 0, // TPIC: C_p = sum_i v_i grad N_ip^T, any shape function
+    b_d_inverse       = 1  // APIC (Jiang et al. 2015): C_p = B_p D_p^-1, B_p = sum_i N_ip v_i r_i^T, with
+                           // the B-splines' constant D_p (h^2/4 quadratic, h^2/3 cubic); for linear
+                           // weights it equals the gradient form; GIMP has no constant D_p (refused)
+  };
+
   template <int dim, typename Real>
   struct StepSettings
   {
@@ -58,13 +67,14 @@ namespace mpm
     // modes relax over thousands of steps (doc/log.md). The first held step, with this
     // set, starts from the points' momentum.
     bool hold_from_point_momentum = false;
-    // APIC (Jiang et al. 2015) instead of the FLIP/PIC blend: a point carries an affine
-    // velocity matrix C_p (dim x dim, row-major) in p.state_variables[affine_state_variable
-    // + a dim + b], its momentum reaches the grid as m N_i (v_p + C_p (x_i - x_p)), and G2P
-    // gives PIC's velocity and C_p (apic_affine_matrix). flip_fraction must be
-    // 0. -1: no APIC. Host backends whose stages use HostStencil only (the CPU's; explicit_step
-    // refuses the others).
-    int affine_state_variable = -1;
+    // An affine transfer (APIC or TPIC, affine_matrix) instead of the FLIP/PIC blend: a point
+    // carries an affine velocity matrix C_p (dim x dim, row-major) in
+    // p.state_variables[affine_state_variable + a dim + b], its momentum reaches the grid as
+    // m N_i (v_p + C_p (x_i - x_p)), and G2P gives PIC's velocity and C_p (affine_matrix_of).
+    // flip_fraction must be 0. -1: neither. Host backends whose stages use HostStencil only
+    // (the CPU's; explicit_step refuses the others).
+    int          affine_state_variable = -1;
+    AffineMatrix affine_matrix         = AffineMatrix::velocity_gradient;
     // A body acceleration of each point's own, added to gravity in P2G: dim state variables
     // from p.state_variables[body_force_state_variable] that the caller sets before each step
     // (the manufactured solutions of tests/core/manufactured_solution.h). -1: none. Host
@@ -230,19 +240,46 @@ namespace mpm
       return g.cell_pressure_volume[c] / g.cell_volume[c] - mean;
     }
 
+    // APIC's D_p / h^2 for a shape function (Jiang et al. 2015), 0 where it has none constant.
+    template <typename Shape>
+    constexpr double apic_inertia_over_h2()
+    {
+      if constexpr (std::is_same_v<Shape, QuadraticBSplineShape>)
+        return 0.25;
+      else if constexpr (std::is_same_v<Shape, CubicBSplineShape>)
+        return 1.0 / 3.0;
+      else
+        return 0;
+    }
+
 #if !defined(__CUDA_ARCH__) && !defined(MPM_UNROLL_STENCIL)
-    // APIC's affine matrix of a point from the nodal velocities v_i (`nodal`), in the gradient
-    // form C = sum_i v_i grad N_i^T (Jiang et al.'s B D^-1 for linear weights; for others D_p is
-    // computed from the stencil, and near the grid's faces, where nodes are missing, it becomes
-    // nearly singular: the V3 collapse blew up at 0.48 s with it, doc/log.md). Exact for affine
-    // fields v = A x + b wherever the weights reproduce linear fields: sum (A x_i + b) grad N_i^T
-    // = A sum x_i grad N_i^T = A.
+    // The affine matrix of a point from the nodal velocities v_i (`nodal`).
+    // TPIC, the gradient form C = sum_i v_i grad N_i^T: exact for affine fields v = A x + b
+    // wherever the weights reproduce linear fields (sum (A x_i + b) grad N_i^T = A), any shape.
+    // APIC, C = B_p D_p^-1 with B_p = sum_i N_i v_i (x_i - x_p)^T and the B-splines' constant D_p:
+    // exact for affine fields where sum_i N_i r_i r_i^T = D_p, i.e. away from the grid's faces
+    // (there the folded weights give a smaller sum, and C is damped towards 0, never amplified).
+    // A D_p computed from each stencil instead turns nearly singular at the faces (the V3
+    // collapse blew up at 0.48 s with it, doc/log.md). Linear weights: APIC's B D^-1 is the
+    // gradient form (Jiang et al.), which is what is computed.
     template <int dim, typename Shape, typename Real>
-    inline void apic_affine_matrix(const GridView<dim, Real> &g, Real *const *nodal,
-                                   const HostStencil<dim, Shape, Real> &stencil, Real C[dim * dim])
+    inline void affine_matrix_of(const GridView<dim, Real> &g, Real *const *nodal,
+                                 const HostStencil<dim, Shape, Real> &stencil, const Real x[dim],
+                                 const AffineMatrix form, Real C[dim * dim])
     {
       for (int k = 0; k < dim * dim; ++k)
         C[k] = Real(0);
+      constexpr double inertia = apic_inertia_over_h2<Shape>();
+      if (form == AffineMatrix::b_d_inverse && inertia > 0)
+        {
+          const Real scale = Real(1) / (Real(inertia) * g.h * g.h);
+          stencil.for_each_with_offset(g, x, [&](const int n, const Real N, const Real *, const Real *r) {
+            for (int a = 0; a < dim; ++a)
+              for (int b = 0; b < dim; ++b)
+                C[a * dim + b] += scale * N * nodal[a][n] * r[b];
+          });
+          return;
+        }
       stencil.for_each(g, [&](const int n, const Real, const Real *grad) {
         for (int a = 0; a < dim; ++a)
           for (int b = 0; b < dim; ++b)
@@ -526,7 +563,7 @@ namespace mpm
         if (s.affine_state_variable >= 0) // from v^{n+1}, which update_grid left in force[] (flip_fraction 0)
           {
             Real C[dim * dim];
-            apic_affine_matrix<dim>(g, g.force, HostStencil<dim, Shape, Real>(g, x, lp), C);
+            affine_matrix_of<dim>(g, g.force, HostStencil<dim, Shape, Real>(g, x, lp), x, s.affine_matrix, C);
             store_affine(p, s, i, C);
           }
 #endif
@@ -585,7 +622,7 @@ namespace mpm
         if (s.affine_state_variable >= 0) // C from v^{n+1} (force[], flip_fraction 0), then its momentum
           {
             Real C[dim * dim];
-            apic_affine_matrix<dim>(g, g.force, *host_stencil, C);
+            affine_matrix_of<dim>(g, g.force, *host_stencil, x, s.affine_matrix, C);
             store_affine(p, s, i, C);
             add_apic_momentum<Backend>(g, *host_stencil, x, m, C);
           }
@@ -915,6 +952,10 @@ namespace mpm
           throw std::invalid_argument("explicit_step: APIC needs flip_fraction = 0 (its velocity is PIC's)");
         if (p.n_state_variables < s.affine_state_variable + dim * dim)
           throw std::invalid_argument("explicit_step: APIC's affine matrix needs dim x dim state variables");
+        if (s.affine_matrix == AffineMatrix::b_d_inverse && apic_inertia_over_h2<Shape>() == 0 &&
+            !std::is_same_v<Shape, LinearShape>)
+          throw std::invalid_argument("explicit_step: APIC (B D^-1) needs a shape function with a constant D_p "
+                                      "(the B-splines) or linear weights; GIMP has neither (TPIC runs with it)");
       }
     if (s.body_force_state_variable >= 0)
       {

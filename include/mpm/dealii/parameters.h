@@ -64,7 +64,10 @@ namespace mpm
     LocalDampingForm damping_form;
     double       damping_threshold; // m/s
     double       flip_fraction;
-    bool         apic = false; // Solver/Velocity transfer = APIC: C_p in the last dim x dim state variables
+    // Solver/Velocity transfer = APIC or TPIC: an affine transfer, C_p in the last dim x dim state
+    // variables, computed as affine_matrix says
+    bool         apic          = false;
+    AffineMatrix affine_matrix = AffineMatrix::velocity_gradient;
     std::vector<double> gravity;
     double       gravity_ramp_time;
     double       plasticity_start_time;
