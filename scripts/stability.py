@@ -41,6 +41,8 @@ METHODS = {
                                         "set GIMP domain update = none"]),
     "ugimp_tpic": ("uGIMP, TPIC", ["set Shape function = GIMP", "set GIMP domain update = none",
                                    "set Velocity transfer = TPIC"]),
+    "bspline2_apic": ("quadratic B-spline, APIC", ["set Shape function = quadratic B-spline",
+                                                   "set GIMP domain update = none", "set Velocity transfer = APIC"]),
     # Material entries: "@material" stands for each material of the scene's prm.
     "cpgimp_u_hencky": ("cpGIMP U, Hencky", ["set Shape function = GIMP", "set GIMP domain update = U"],
                         ["@material", "  set Elastic law = Hencky", "end"]),
