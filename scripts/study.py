@@ -8,7 +8,10 @@ log-log, one marker per method, the front of runs no other run beats in both) an
 convergence plot. doc/methods.md ("The study") gives the results.
 
   study.py --exe build/dealii-mpm --out DIR [--scenes v1,v2,v3,mms] [--methods a,b] [--reduced]
-           [--csv FILE] [--figures DIR] [--check] [--mms-exe build/tests/core/mms_study]
+           [--csv FILE] [--figures DIR] [--check] [--mms-exe build/tests/core/mms_study] [--backend cpu|cuda]
+
+--backend cuda: the runs through dealii-mpm with Backend = cuda (a build with CUDA, on a GPU machine; TPIC,
+APIC and Hencky run on the CPU only and are refused there; the MMS runs in the core on the CPU whatever this says).
 
 --reduced: the coarse levels only (the ctest); --check: assert that every run is stable and its error
 within the scene's bound (not the times), exit 1 if one is not. The bounds are what a usable method
@@ -133,16 +136,28 @@ def run_mms(mms_exe, method, h):
     return row
 
 
-def run_one(exe, out_root, scene, method, h, overrides, mms_exe=None):
+def gpu_name():
+    try:
+        done = subprocess.run(["nvidia-smi", "--query-gpu=name", "--format=csv,noheader"], capture_output=True,
+                              text=True)
+        return done.stdout.strip().splitlines()[0]
+    except (OSError, IndexError):
+        return "unknown GPU"
+
+
+def run_one(exe, out_root, scene, method, h, overrides, mms_exe=None, backend="cpu"):
     if scene == "mms":
         return run_mms(mms_exe, method, h)
     prm, material, _, _, solver, error_of, _ = SCENES[scene]
     label, method_solver, method_other = METHODS[method]
     other = [f"subsection Material {material}" if x == "@material" else x for x in method_other]
+    if backend == "cuda":
+        other += ["subsection Backend", "  set Backend = cuda", "end"]
     out = os.path.join(out_root, f"{scene}-{method}-{h:g}")
     done = mpm_runs.run(exe, prm, out, overrides + other, solver + method_solver)
-    row = {"scene": scene, "method": method, "h": h, "precision": "FP64", "backend": "cpu",
-           "machine": mpm_runs.machine(), "date": mpm_runs.today(), "wall_s": done["wall_s"],
+    where = mpm_runs.machine() + (f", {gpu_name()}" if backend == "cuda" else "")
+    row = {"scene": scene, "method": method, "h": h, "precision": "FP64", "backend": backend,
+           "machine": where, "date": mpm_runs.today(), "wall_s": done["wall_s"],
            "steps": done.get("steps", ""), "point_updates_per_s": done.get("point_updates_per_s", "")}
     if done["status"] != "finished":
         row.update(points="", error="", stable="no", details=done["message"][:200])
@@ -225,6 +240,7 @@ def main():
     ap.add_argument("--csv")
     ap.add_argument("--figures")
     ap.add_argument("--check", action="store_true")
+    ap.add_argument("--backend", choices=["cpu", "cuda"], default="cpu")
     ap.add_argument("--mms-exe", help="the core program mms_study (default: tests/core/mms_study beside --exe)")
     args = ap.parse_args()
     mms_exe = args.mms_exe or os.path.join(os.path.dirname(os.path.abspath(args.exe)), "tests", "core", "mms_study")
@@ -235,7 +251,8 @@ def main():
             for h, overrides in levels:
                 if args.reduced and not any(abs(h - r) < 1e-12 for r in reduced):
                     continue
-                row = run_one(args.exe, os.path.abspath(args.out), scene, method, h, overrides, mms_exe)
+                row = run_one(args.exe, os.path.abspath(args.out), scene, method, h, overrides, mms_exe,
+                              args.backend)
                 rows.append(row)
                 print(f"{scene} {METHODS[method][0]:32s} h={h:<8.4g} error={row['error']!s:22.22s} "
                       f"wall={row['wall_s']:.2f}s stable={row['stable']} {row['details']}", flush=True)
