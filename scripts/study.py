@@ -193,24 +193,32 @@ def draw(rows, figures):
         mine = [r for r in rows if r["scene"] == scene and r["stable"] == "yes" and float(r["error"]) > 0]
         if not mine:
             continue
-        fig, ax = plt.subplots(figsize=(7, 5))
+        fig, ax = plt.subplots(figsize=(10, 5.5))
+        backends = sorted({r.get("backend", "cpu") for r in mine})
         for k, method in enumerate(METHODS):
-            pts = [(float(r["wall_s"]), float(r["error"])) for r in mine if r["method"] == method]
-            if pts:
-                ax.loglog(*zip(*pts), markers[k % len(markers)], label=METHODS[method][0], alpha=0.8)
+            for backend in backends:
+                pts = [(float(r["wall_s"]), float(r["error"])) for r in mine
+                       if r["method"] == method and r.get("backend", "cpu") == backend]
+                if pts:
+                    hollow = {"mfc": "none"} if backend == "cuda" else {}
+                    label = METHODS[method][0] + (" (cuda)" if backend == "cuda" else "")
+                    ax.loglog(*zip(*pts), markers[k % len(markers)], label=label, alpha=0.8, color=f"C{k % 10}",
+                              **hollow)
         pts = [(float(r["wall_s"]), float(r["error"])) for r in mine]
         front = [pts[i] for i in pareto_front(pts)]
         ax.step(*zip(*front), where="post", color="k", lw=1, label="Pareto front")
-        ax.set_xlabel("wall time (s), CPU backend, FP64")
+        ax.set_xlabel("wall time (s), FP64" + ("; filled: CPU backend, hollow: CUDA" if "cuda" in backends else
+                                               ", CPU backend"))
         ax.set_ylabel("error")
-        ax.set_title(f"{scene.upper()}: error against cost ({mine[0]['date']}, {mine[0]['machine']})", fontsize=8)
-        ax.legend(fontsize=7)
+        where = sorted({r["machine"] for r in mine})
+        ax.set_title(f"{scene.upper()}: error against cost ({'; '.join(where)})", fontsize=7)
+        ax.legend(fontsize=6, loc="center left", bbox_to_anchor=(1.01, 0.5))
         fig.tight_layout()
         fig.savefig(os.path.join(figures, f"study_{scene}_pareto.png"), dpi=110)
         plt.close(fig)
     for scene, what, title in (("v1", "V1 error norm", "V1 column"),
                                ("mms", "MMS position error / amplitude", "Manufactured solution")):
-        mine = [r for r in rows if r["scene"] == scene and r["stable"] == "yes"]
+        mine = [r for r in rows if r["scene"] == scene and r["stable"] == "yes" and r.get("backend", "cpu") == "cpu"]
         if not mine:
             continue
         fig, ax = plt.subplots(figsize=(7, 5))
