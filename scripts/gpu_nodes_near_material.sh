@@ -11,17 +11,8 @@ ROOT=$(cd "$(dirname "$0")/.." && pwd)
 BIN=$(cd "${BIN:-$ROOT/build-cuda/dev}" && pwd)
 OUT=${OUT:-$ROOT/out}
 mkdir -p "$OUT"
-export LD_LIBRARY_PATH="$BIN${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
-export OMPI_MCA_ess_singleton_isolated=1
-DL=${DL:-/opt/dl}
-for xz in "$BIN"/*.xz; do
-  [ -f "$xz" ] || continue
-  target=$BIN/$(basename "$xz" .xz)
-  case $(basename "$xz") in libdeal.ii*) target=$DL/lib/$(basename "$xz" .xz) ;; esac
-  [ -e "$target" ] || python3 -c "import lzma,shutil,sys; shutil.copyfileobj(lzma.open(sys.argv[1]), open(sys.argv[2],'wb'))" "$xz" "$target"
-done
-chmod +x "$BIN"/dealii-mpm
-nvidia-smi --query-gpu=name,driver_version,memory.total --format=csv,noheader | tee "$OUT/machine.txt"
+. "$ROOT/scripts/gpu_unpack_build.sh"
+prepare_build "$BIN" "$OUT"
 idle=$(nvidia-smi --query-gpu=memory.used --format=csv,noheader,nounits | head -1)
 
 echo "== GPU test: near material against every node" | tee -a "$OUT/summary.txt"

@@ -6,17 +6,10 @@
 #   OLD=dir NEW=dir [ROUNDS=3] bash scripts/gpu_p2_old_new.sh
 set -u -o pipefail
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
-DL=${DL:-/opt/dl}
 export OMPI_MCA_ess_singleton_isolated=1
-for dir in "$OLD" "$NEW"; do
-  for xz in "$dir"/*.xz; do
-    [ -f "$xz" ] || continue
-    target=$dir/$(basename "$xz" .xz)
-    case $(basename "$xz") in libdeal.ii*) target=$DL/lib/$(basename "$xz" .xz) ;; esac
-    [ -e "$target" ] || python3 -c "import lzma,shutil,sys; shutil.copyfileobj(lzma.open(sys.argv[1]), open(sys.argv[2],'wb'))" "$xz" "$target"
-  done
-  chmod +x "$dir/dealii-mpm"
-done
+. "$ROOT/scripts/gpu_unpack_build.sh"
+unpack_build "$OLD"
+unpack_build "$NEW"
 prm=/tmp/p2_old_new.prm
 cp "$ROOT/prm/granular_collapse_3d.prm" "$prm"
 printf '%s\n' "subsection Output" "  set Directory = /tmp/p2-old-new" "  set Progress interval = 0" "end" \

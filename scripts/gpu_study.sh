@@ -10,17 +10,8 @@ OUT=${OUT:-$ROOT/out}
 SCENES=${SCENES:-v1,v2,v3}
 METHODS=${METHODS:-gimp,linear,cpgimp_det_f,cpgimp_f_ii,cpgimp_u,bspline2,bspline3,gimp_pic,gimp_flip,bspline2_pic}
 mkdir -p "$OUT"
-export LD_LIBRARY_PATH="$BIN${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
-export OMPI_MCA_ess_singleton_isolated=1
-DL=${DL:-/opt/dl}
-for xz in "$BIN"/*.xz; do
-  [ -f "$xz" ] || continue
-  target=$BIN/$(basename "$xz" .xz)
-  case $(basename "$xz") in libdeal.ii*) target=$DL/lib/$(basename "$xz" .xz) ;; esac
-  [ -e "$target" ] || python3 -c "import lzma,shutil,sys; shutil.copyfileobj(lzma.open(sys.argv[1]), open(sys.argv[2],'wb'))" "$xz" "$target"
-done
-chmod +x "$BIN"/dealii-mpm
-nvidia-smi --query-gpu=name,driver_version,memory.total --format=csv,noheader | tee "$OUT/machine.txt"
+. "$ROOT/scripts/gpu_unpack_build.sh"
+prepare_build "$BIN" "$OUT"
 tag=${SCENES//,/_}
 python3 "$ROOT/scripts/study.py" --exe "$BIN/dealii-mpm" --backend cuda --out /tmp/study-cuda --scenes "$SCENES" \
   --methods "$METHODS" --csv "$OUT/study_cuda_$tag.csv" 2>&1 | tee "$OUT/study_cuda_$tag.log"

@@ -1,0 +1,22 @@
+# Sourced by the GPU scripts: unpack_build DIR makes a build folder carried to the GPU machine
+# runnable: each FILE.xz in it is decompressed beside it (libdeal.ii*.xz into $DL/lib, the unpacked
+# deal.II runtime, default /opt/dl), and dealii-mpm made executable.
+unpack_build() {
+  local dir=$1 xz target
+  for xz in "$dir"/*.xz; do
+    [ -f "$xz" ] || continue
+    target=$dir/$(basename "$xz" .xz)
+    case $(basename "$xz") in libdeal.ii*) target=${DL:-/opt/dl}/lib/$(basename "$xz" .xz) ;; esac
+    [ -e "$target" ] || python3 -c "import lzma,shutil,sys; shutil.copyfileobj(lzma.open(sys.argv[1]), open(sys.argv[2],'wb'))" "$xz" "$target"
+  done
+  chmod +x "$dir/dealii-mpm"
+}
+
+# prepare_build DIR OUT: unpack_build DIR, put DIR first on the library path, let a singleton start without
+# mpirun's daemon, and record the GPU in OUT/machine.txt.
+prepare_build() {
+  unpack_build "$1"
+  export LD_LIBRARY_PATH="$1${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
+  export OMPI_MCA_ess_singleton_isolated=1
+  nvidia-smi --query-gpu=name,driver_version,memory.total --format=csv,noheader | tee "$2/machine.txt"
+}
