@@ -475,7 +475,7 @@ namespace mpm
                 << static_cast<long>(sum(double(s.points->n_sent), s.communicator)) << " points migrated, "
                 << s.n_repartitions << " repartitions; work per rank max/mean " << s.imbalance() << "\n"
                 << "  MPI: the points' distances from their home cells checked in " << s.n_home_checks << " of "
-                << steps << " steps (in the others a bound from the largest speed showed no point could be "
+                << steps << " steps (in the others a bound from the largest speed showed no point could be more than "
                 << s.resort_at << " cells out)\n";
         // Ghost exchange per step: import + export of every ghost node's value, for each
         // array the scheme sums (MUSL: mass, momentum, force, then momentum again).

@@ -176,10 +176,10 @@ namespace mpm
     double                     engine_setup_seconds = 0;
     bool                       initial_output_pending = false;
 
-    double resort_at = 1e300;
+    double resort_at = 1e300; // re-sort (or choose the nodes again) once a point is farther out than this
     // Several ranks: a bound on the distance of any point outside its home cell (cells): the
     // largest distance at the last check (0 after a re-sort) plus step_displacement_bound of
-    // every step since; the points are checked only once it reaches resort_at (n_home_checks
+    // every step since; the points are checked only once it exceeds resort_at (n_home_checks
     // counts those checks). Unknown until the first check: a resumed run's points may sit
     // outside the cells they were saved in.
     double drift_bound = std::numeric_limits<double>::infinity();
@@ -361,7 +361,7 @@ namespace mpm
                                          " cells outside the cell it was sorted into, beyond the ghost cells "
                                          "whose pressure sums are exchanged between ranks. Reduce 'Solver/CFL "
                                          "number' or the time step."));
-          if (distance >= resort_at)
+          if (distance > resort_at)
             {
               {
                 dealii::TimerOutput::Scope scope(timer, "migrate points");
@@ -385,7 +385,7 @@ namespace mpm
                                          "chosen, beyond the kept cells whose pressure sums the step used (Grid/"
                                          "Active block size = " + std::to_string(parameters.active_block_cells) +
                                          "). Reduce 'Solver/CFL number' or the time step, or enlarge the blocks."));
-          if (distance >= resort_at)
+          if (distance > resort_at)
             {
               engine->refresh_active_nodes();
               ++n_node_refreshes;
@@ -553,7 +553,7 @@ namespace mpm
             << output->directory() << "'" << std::endl;
       if (engine->follows_material())
         pcout << "  nodes near the material: " << engine->n_active_nodes() << " of the " << n_nodes
-              << " (blocks of " << parameters.active_block_cells << " cells), chosen again once a point is "
+              << " (blocks of " << parameters.active_block_cells << " cells), chosen again once a point is more than "
               << resort_at << " cells out of the cell it was in" << std::endl;
       else if (parallel && parameters.active_block_cells > 0)
         pcout << "  Grid/Nodes = near material is for one rank so far: each rank keeps every node of its part "
@@ -688,7 +688,7 @@ namespace mpm
     {
       drift_bound += step_displacement_bound(dt);
       double     distance = drift_bound;
-      const bool needed   = !(drift_bound < resort_at);
+      const bool needed   = !(drift_bound <= resort_at);
       if (needed || verify_drift_bound)
         {
           distance = global_max(engine->max_distance_outside_home_cells());
