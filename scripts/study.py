@@ -202,7 +202,8 @@ def draw(rows, figures):
                 if pts:
                     hollow = {"mfc": "none"} if backend == "cuda" else {}
                     label = METHODS[method][0] + (" (cuda)" if backend == "cuda" else "")
-                    ax.loglog(*zip(*pts), markers[k % len(markers)], label=label, alpha=0.8, color=f"C{k % 10}",
+                    ax.loglog(*zip(*pts), markers[k % len(markers)], label=label, alpha=0.8,
+                              color=plt.cm.tab20(k % 20),
                               **hollow)
         pts = [(float(r["wall_s"]), float(r["error"])) for r in mine]
         front = [pts[i] for i in pareto_front(pts)]
@@ -221,18 +222,19 @@ def draw(rows, figures):
         mine = [r for r in rows if r["scene"] == scene and r["stable"] == "yes" and r.get("backend", "cpu") == "cpu"]
         if not mine:
             continue
-        fig, ax = plt.subplots(figsize=(7, 5))
+        fig, ax = plt.subplots(figsize=(9, 5))
         for k, method in enumerate(METHODS):
             pts = sorted((float(r["h"]), float(r["error"])) for r in mine if r["method"] == method)
             if pts:
-                ax.loglog(*zip(*pts), "-" + markers[k % len(markers)], label=METHODS[method][0])
+                ax.loglog(*zip(*pts), "-" + markers[k % len(markers)], label=METHODS[method][0],
+                          color=plt.cm.tab20(k % 20))
         h = np.array(sorted({float(r["h"]) for r in mine}))
         middle = [float(r["error"]) for r in mine if float(r["h"]) == h[len(h) // 2]]
         ax.loglog(h, min(middle) * (h / h[len(h) // 2]) ** 2, "k:", label="order 2")
         ax.set_xlabel("cell size h (m)")
         ax.set_ylabel(what)
-        ax.set_title(f"{title}: convergence", fontsize=9)
-        ax.legend(fontsize=7)
+        ax.set_title(f"{title}: convergence (CPU backend, FP64)", fontsize=9)
+        ax.legend(fontsize=7, loc="center left", bbox_to_anchor=(1.01, 0.5))
         fig.tight_layout()
         fig.savefig(os.path.join(figures, f"study_{scene}_convergence.png"), dpi=110)
         plt.close(fig)
