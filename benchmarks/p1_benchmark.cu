@@ -55,6 +55,12 @@ namespace
     int              sort_every     = 20;
     ShapeFunction    shape          = ShapeFunction::gimp;
     DomainUpdate     domain         = DomainUpdate::det_F; // GIMP's; P1's own is det F
+    // --transfer tpic|apic: an affine transfer instead of P1's FLIP/PIC blend; --law hencky.
+    // Either runs the step's kernels that hold them (DevicePhysics::all).
+    bool             affine   = false;
+    AffineMatrix     affine_matrix = AffineMatrix::velocity_gradient;
+    bool             hencky   = false;
+    bool             all_physics() const { return affine || hencky; }
   };
 
   // Reorder every point array by perm (new point i is old point perm[i]).
@@ -185,6 +191,11 @@ namespace
     std::vector<MaterialParameters<Real>> materials;
     mpm_bench::make_p1(n_cells_y, grid, points, materials, opt.drucker_prager);
     reorder(points, grid, opt.order);
+    if (opt.affine) // the affine matrices, zero at the start
+      points.set_n_state_variables(3 * 3);
+    if (opt.hencky)
+      for (MaterialParameters<Real> &m : materials)
+        m.elastic_law = ElasticLaw::hencky;
     const int  n_points = points.size();
     const long n_cells  = long(grid.n_cells[0]) * grid.n_cells[1] * grid.n_cells[2];
     const int  n_nodes  = static_cast<int>(grid.mass.size());
@@ -217,7 +228,18 @@ namespace
     };
     StepSettings<3, Real> s = mpm_bench::p1_settings<Real>();
     s.domain_update         = opt.shape == ShapeFunction::gimp ? opt.domain : DomainUpdate::none;
+    if (opt.affine)
+      {
+        s.affine_state_variable = 0;
+        s.affine_matrix         = opt.affine_matrix;
+        s.flip_fraction         = 0;
+      }
     const double          c = mpm_bench::p1_wave_speed();
+    auto step = [&](const double dt) {
+      return opt.all_physics() ?
+               explicit_step<3, DevicePhysics::all>(backend, opt.shape, gv, pv, dmaterials.data(), s, Real(dt)) :
+               explicit_step<3>(backend, opt.shape, gv, pv, dmaterials.data(), s, Real(dt));
+    };
 
     // Warm-up (module load, first launches), then back to the initial state.
     {
@@ -227,7 +249,7 @@ namespace
           sort_if_due(i);
           const double dt = P1::cfl * P1::h / (c + max_speed);
           mpm_bench::p1_gravity(s, t);
-          max_speed = explicit_step<3>(backend, opt.shape, gv, pv, dmaterials.data(), s, Real(dt)).max_speed;
+          max_speed = step(dt).max_speed;
           t += dt;
         }
       dgrid.upload(grid);
@@ -249,7 +271,7 @@ namespace
         sort_if_due(steps);
         const double dt = P1::cfl * P1::h / (c + max_speed);
         mpm_bench::p1_gravity(s, t);
-        max_speed = explicit_step<3>(backend, opt.shape, gv, pv, dmaterials.data(), s, Real(dt)).max_speed;
+        max_speed = step(dt).max_speed;
         t += dt;
         ++steps;
       }
@@ -293,6 +315,10 @@ namespace
     if (opt.shape == ShapeFunction::gimp)
       label += opt.domain == DomainUpdate::U ? ", U domains" : opt.domain == DomainUpdate::stretch ? ", F_ii domains" :
                opt.domain == DomainUpdate::none ? ", uGIMP" : ", det F domains";
+    if (opt.affine)
+      label += opt.affine_matrix == AffineMatrix::b_d_inverse ? ", APIC" : ", TPIC";
+    if (opt.hencky)
+      label += ", Hencky";
     label += opt.sort_every > 0 ? ", sorted every " + std::to_string(opt.sort_every) : ", unsorted";
     const double updates  = double(n_points) * steps / wall;
     const double bytes    = minimal_bytes_per_step<Real>(n_points, n_nodes);
@@ -322,7 +348,7 @@ namespace
         for (int i = 0; i < n_prof; ++i)
           {
             const double dt = P1::cfl * P1::h / (c + max_speed);
-            max_speed = explicit_step<3>(backend, opt.shape, gv, pv, dmaterials.data(), s, Real(dt)).max_speed;
+            max_speed = step(dt).max_speed;
             const std::vector<float> times = backend.kernel_times_ms();
             for (size_t k = 0; k < times.size() && k < sum.size(); ++k)
               sum[k] += times[k];
@@ -399,6 +425,27 @@ int main(int argc, char **argv)
           opt.domain = m == "detF" ? DomainUpdate::det_F : m == "Fii" ? DomainUpdate::stretch :
                        m == "U"    ? DomainUpdate::U : DomainUpdate::none;
         }
+      else if (a == "--transfer" && i + 1 < argc)
+        {
+          const std::string m = argv[++i];
+          if (m != "tpic" && m != "apic")
+            {
+              std::printf("--transfer: expected tpic or apic, got %s\n", m.c_str());
+              return 2;
+            }
+          opt.affine        = true;
+          opt.affine_matrix = m == "apic" ? AffineMatrix::b_d_inverse : AffineMatrix::velocity_gradient;
+        }
+      else if (a == "--law" && i + 1 < argc)
+        {
+          const std::string m = argv[++i];
+          if (m != "hencky" && m != "jaumann")
+            {
+              std::printf("--law: expected jaumann or hencky, got %s\n", m.c_str());
+              return 2;
+            }
+          opt.hencky = m == "hencky";
+        }
       else if (a == "--block" && i + 1 < argc)
         opt.block = std::atoi(argv[++i]);
       else if (a == "--table" && i + 1 < argc)
@@ -419,10 +466,17 @@ int main(int argc, char **argv)
         {
           std::printf("usage: %s [--fp32] [--sizes 20,160,640,2560] [--steps N] [--profile] [--table FILE]\n"
                       "          [--order generated|cell|random] [--block N] [--material dp|elastic] [--sort-every N]\n"
-                      "          [--shape gimp|linear|bspline2|bspline3] [--domain detF|Fii|U|none]\n",
+                      "          [--shape gimp|linear|bspline2|bspline3] [--domain detF|Fii|U|none]\n"
+                      "          [--transfer tpic|apic] [--law jaumann|hencky]\n",
                       argv[0]);
           return 2;
         }
+    }
+  if (opt.affine && opt.affine_matrix == AffineMatrix::b_d_inverse && opt.shape == ShapeFunction::gimp)
+    {
+      std::printf("--transfer apic: needs --shape linear, bspline2 or bspline3 (GIMP has no constant D_p; use "
+                  "--transfer tpic)\n");
+      return 2;
     }
   if (cuda_device_count() == 0)
     {

@@ -3,7 +3,8 @@
 # (12.8M points, 400 steps), and the default path (GIMP det F, Drucker-Prager,
 # Jaumann) timed against an older tree's build, interleaved. Everything goes to $OUT.
 #   scripts/gpu_shape_rows.sh [OLD_TREE]      OLD_TREE: a checkout of the earlier commit
-#   ROWS=0: only the default against the old tree. TESTS=0: no tests; TESTS="a b": those tests
+#   ROWS=0: only the default against the old tree; ROWS=physics: TPIC, APIC and Hencky beside
+#   their standard rows. TESTS=0: no tests; TESTS="a b": those tests
 set -u -o pipefail
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
 OUT=${OUT:-$ROOT/output-gpu}
@@ -36,6 +37,14 @@ row() { echo "== $* ($(date +%T))"; timeout 150 "$@" $P 2>&1 | grep -E "^\| " | 
       row /tmp/old/benchmarks/p1_benchmark
       row /tmp/new/benchmarks/p1_benchmark
     done
+  fi
+  if [ "${ROWS:-1}" = physics ]; then # the affine transfers and Hencky (DevicePhysics::all) beside the standard rows
+    row /tmp/new/benchmarks/p1_benchmark --domain none
+    row /tmp/new/benchmarks/p1_benchmark --domain none --transfer tpic
+    row /tmp/new/benchmarks/p1_benchmark --shape bspline2
+    row /tmp/new/benchmarks/p1_benchmark --shape bspline2 --transfer apic
+    row /tmp/new/benchmarks/p1_benchmark --law hencky
+    row /tmp/new/benchmarks/p1_benchmark --domain U --law hencky
   fi
   if [ "${ROWS:-1}" = 1 ]; then
     row /tmp/new/benchmarks/p1_benchmark --shape linear

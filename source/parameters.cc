@@ -190,8 +190,8 @@ namespace mpm
                       "and C; both keep angular momentum through the transfers without FLIP's noise. TPIC "
                       "(Taylor PIC): C = sum_i v_i grad N_i, with any Shape function. APIC (Jiang et al. 2015): "
                       "C = B D^-1 with the B-splines' constant D (h^2/4 quadratic, h^2/3 cubic), equal to TPIC's "
-                      "for linear; it needs Shape function = linear, quadratic B-spline or cubic B-spline. CPU "
-                      "backend only for now. C starts at zero.");
+                      "for linear; it needs Shape function = linear, quadratic B-spline or cubic B-spline. Both "
+                      "backends. C starts at zero.");
     prm.declare_entry("Gravity", zeros(dim, -9.81), point_pattern(dim),
                       "Gravitational acceleration vector (m/s^2).");
     prm.declare_entry("Gravity ramp time", "0", Patterns::Double(0),
@@ -226,8 +226,8 @@ namespace mpm
                           "stress rotated with the spin plus C : d_eps per step. Hencky: hyperelastic in "
                           "logarithmic strain (Kirchhoff stress = C : ln V_e), plasticity multiplicative with the "
                           "model's return mapping in principal logarithmic strains (doc/theory-plasticity.md). The "
-                          "two agree at small strain. Hencky runs on the CPU backend only, and not with models "
-                          "defined outside the library.");
+                          "two agree at small strain. Both backends; not with models defined outside the "
+                          "library.");
         for (const auto &[model, plugin] : material_library())
           {
             prm.enter_subsection(model);
@@ -784,15 +784,6 @@ namespace mpm
             fail("Backend/Backend", "cuda cannot run material '" + material_names[i] + "': its model '" +
                                       material_models[i] + "' is defined outside the library and runs on the "
                                       "CPU backend only (Backend = cpu).");
-          else if (apic)
-            fail("Backend/Backend", "cuda cannot run Solver/Velocity transfer = " +
-                                      std::string(affine_matrix == AffineMatrix::b_d_inverse ? "APIC" : "TPIC") +
-                                      ": it runs on the CPU backend only for now (Backend = cpu, or Velocity "
-                                      "transfer = FLIP/PIC blend).");
-          else if (materials[i].elastic_law == ElasticLaw::hencky)
-            fail("Backend/Backend", "cuda cannot run material '" + material_names[i] + "': its Elastic law = "
-                                      "Hencky runs on the CPU backend only for now (Backend = cpu, or Material " +
-                                      material_names[i] + "/Elastic law = Jaumann rate).");
         }
 
     prm.enter_subsection("Resources");

@@ -262,7 +262,7 @@ namespace mpm
                       HostPoints<dim, double> &host, SlotScratch &scratch, const cudaStream_t stream)
       {
         const int m = static_cast<int>(slots.size());
-        host.set_n_state_variables(0); // the device runs the library's models, which have none
+        host.set_n_state_variables(points.n_state_variables()); // the affine transfers' matrices, if any
         host.resize(m);
         size_t bytes = 0;
         for_each_point_array<dim>(points, host, [&](const auto &array, auto &) {
@@ -293,6 +293,16 @@ namespace mpm
             std::memcpy(to.data(), scratch.host_packed.data() + at, m * sizeof(T));
           at += (m * sizeof(T) + 7) / 8 * 8;
         });
+      }
+
+      // Whether a material of the table asks for Hencky's law (its kernels are the step's
+      // DevicePhysics::all variant).
+      inline bool uses_hencky(const std::vector<MaterialParameters<double>> &materials)
+      {
+        for (const MaterialParameters<double> &m : materials)
+          if (m.elastic_law == ElasticLaw::hencky)
+            return true;
+        return false;
       }
 
       // The step's exchange hook: nothing on one rank, the NodalExchange through the
@@ -356,6 +366,8 @@ namespace mpm
       DeviceArray<double>          cell_volume, cell_pressure_volume;
       long                         n_lattice_cells = 1;
       ShapeFunction                shape;
+      // A material asks for Hencky's law: the step runs the kernels that hold it.
+      bool                         hencky = false;
       Staging<int>                 exchanged_nodes;
       Staging<long>                exchanged_cells;
       ExchangeAdapter              exchange;
@@ -480,6 +492,7 @@ namespace mpm
       impl->grid.upload(host); // no lookup: lattice order from node_offset on
       impl->grid.node_offset = node_offset;
       impl->materials.upload(materials);
+      impl->hencky = uses_hencky(materials);
       impl->exchange = ExchangeAdapter{exchange, &impl->backend, &impl->exchanged_nodes, &impl->exchanged_cells};
       if (exchange != nullptr)
         {
@@ -585,9 +598,16 @@ namespace mpm
       const long step_index = impl->steps_since_upload - 1;
       const bool timed      = impl->timed_from >= 0 && step_index >= impl->timed_from && impl->n_timed_steps < 5;
       impl->backend.enable_kernel_timing(timed);
-      const StepReduction<double> r = explicit_step<dim>(impl->backend, impl->shape, g, impl->points.view(),
-                                                         impl->materials.data(), s, dt, impl->exchange,
-                                                         &impl->averaging_pending);
+      if (s.affine_state_variable >= 0 && impl->points.n_state_variables() < s.affine_state_variable + dim * dim)
+        throw std::invalid_argument("DeviceEngine::step: the affine transfers need the points uploaded with their "
+                                    "affine matrices (dim x dim state variables)");
+      const bool all_physics = impl->hencky || s.affine_state_variable >= 0;
+      const StepReduction<double> r =
+        all_physics ? explicit_step<dim, DevicePhysics::all>(impl->backend, impl->shape, g, impl->points.view(),
+                                                              impl->materials.data(), s, dt, impl->exchange,
+                                                              &impl->averaging_pending) :
+                      explicit_step<dim>(impl->backend, impl->shape, g, impl->points.view(), impl->materials.data(),
+                                         s, dt, impl->exchange, &impl->averaging_pending);
       if (timed)
         {
           const std::vector<float> times = impl->backend.kernel_times_ms();
@@ -622,6 +642,7 @@ namespace mpm
     {
       impl->backend.synchronize(); // the table may be in use by a launch in flight
       impl->materials.upload(materials);
+      impl->hencky = uses_hencky(materials);
     }
 
     template <int dim>
@@ -803,8 +824,9 @@ namespace mpm
       const int          m      = impl->points.size();
       const int          r      = added.size();
       const cudaStream_t stream = impl->backend.get_stream();
-      if (added.n_state_variables() != 0)
-        throw std::invalid_argument("DeviceEngine::append_points: the device holds no state variables");
+      if (added.n_state_variables() != impl->points.n_state_variables())
+        throw std::invalid_argument("DeviceEngine::append_points: the added points hold another number of state "
+                                    "variables than the device's");
       if (added_labels.size() != impl->labels.size())
         throw std::invalid_argument("DeviceEngine::append_points: not as many label arrays as were uploaded");
       for (std::size_t k = 0; k < added_labels.size(); ++k)

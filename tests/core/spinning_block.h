@@ -32,6 +32,7 @@ namespace mpm_test
     double            flip_fraction = 1;
     bool              apic          = false;
     mpm::AffineMatrix affine        = mpm::AffineMatrix::velocity_gradient;
+    mpm::UpdateScheme scheme        = mpm::UpdateScheme::musl;
   };
 
   // Spins the block by `turn` radians at 2 rad/s; `points` receives the final state,
@@ -99,7 +100,7 @@ namespace mpm_test
     material.elastic.poissons_ratio = nu;
 
     StepSettings<dim, double> s;
-    s.scheme = UpdateScheme::musl;
+    s.scheme = transfer.scheme;
     for (int d = 0; d < dim; ++d)
       s.gravity[d] = 0;
     s.damping        = 0;
@@ -120,7 +121,12 @@ namespace mpm_test
         {
           const double dt = std::min(0.5 * h / (c + max_speed), t_end - time);
           const auto   pv = target.template points_at_step<Shape>(r.n_steps);
-          max_speed = explicit_step<dim, Shape>(target.backend, gv, pv, target.material_table(), s, dt).max_speed;
+          // The affine transfers: on the device, the step's kernels that hold them.
+          max_speed = (transfer.apic ?
+                         explicit_step<dim, Shape, DevicePhysics::all>(target.backend, gv, pv, target.material_table(),
+                                                                       s, dt) :
+                         explicit_step<dim, Shape>(target.backend, gv, pv, target.material_table(), s, dt))
+                        .max_speed;
           time += dt;
           ++r.n_steps;
         }

@@ -32,9 +32,10 @@ namespace mpm_test
 
   // n_steps of a scene at the adaptive time step cfl h / (c + largest speed); held scenes
   // (s.hold_points) take their first step from the points' momentum, as the equilibration does.
+  // all_physics: the device's kernels that hold Hencky's law and the affine transfers.
   template <int dim, typename SceneTarget>
   SceneResult step_scene(SceneTarget &target, mpm::StepSettings<dim, double> &s, const double cfl, const double h,
-                         const double c, const long n_steps)
+                         const double c, const long n_steps, const bool all_physics = false)
   {
     auto        gv = target.grid();
     SceneResult r;
@@ -44,8 +45,11 @@ namespace mpm_test
         const double dt            = cfl * h / (c + max_speed);
         s.hold_from_point_momentum = s.hold_points && r.n_steps == 0;
         const auto pv              = target.template points_at_step<mpm::GimpShape>(r.n_steps);
-        max_speed =
-          mpm::explicit_step<dim, mpm::GimpShape>(target.backend, gv, pv, target.material_table(), s, dt).max_speed;
+        max_speed = (all_physics ? mpm::explicit_step<dim, mpm::GimpShape, mpm::DevicePhysics::all>(
+                                     target.backend, gv, pv, target.material_table(), s, dt) :
+                                   mpm::explicit_step<dim, mpm::GimpShape>(target.backend, gv, pv,
+                                                                           target.material_table(), s, dt))
+                      .max_speed;
         r.time += dt;
       }
     target.finish();
@@ -58,13 +62,16 @@ namespace mpm_test
                     const mpm::HostPoints<3, Real> *initial = nullptr, const double damping = mpm_bench::P1::damping,
                     const bool drucker_prager = false,
                     const mpm::LocalDampingForm damping_form = mpm::LocalDampingForm::per_component,
-                    const double damping_threshold = 0)
+                    const double damping_threshold = 0, const mpm::ElasticLaw law = mpm::ElasticLaw::jaumann_rate)
   {
     using namespace mpm;
     using mpm_bench::P1;
     HostGrid<3, Real>                     grid;
     std::vector<MaterialParameters<Real>> materials;
     mpm_bench::make_p1(n_cells_y, grid, points, materials, drucker_prager);
+    for (MaterialParameters<Real> &m : materials)
+      m.elastic_law = law;
+    const bool hencky = law == ElasticLaw::hencky;
     if (initial != nullptr)
       points = *initial; // same scene, points given (e.g. reordered)
     StepSettings<3, Real> s = mpm_bench::p1_settings<Real>();
@@ -81,7 +88,10 @@ namespace mpm_test
         const double dt = P1::cfl * P1::h / (c + max_speed);
         mpm_bench::p1_gravity(s, r.time);
         const auto pv = target.template points_at_step<GimpShape>(r.n_steps);
-        max_speed = explicit_step<3, GimpShape>(target.backend, gv, pv, target.material_table(), s, Real(dt)).max_speed;
+        max_speed = (hencky ? explicit_step<3, GimpShape, DevicePhysics::all>(target.backend, gv, pv,
+                                                                              target.material_table(), s, Real(dt)) :
+                              explicit_step<3, GimpShape>(target.backend, gv, pv, target.material_table(), s, Real(dt)))
+                      .max_speed;
         r.time += dt;
       }
     target.finish();
@@ -96,7 +106,7 @@ namespace mpm_test
   template <template <int, typename> class Target>
   SceneResult collapse(mpm::HostPoints<2, double> &points, const long n_steps,
                        const mpm::HostPoints<2, double> *initial = nullptr, const bool drucker_prager = false,
-                       const bool held = false)
+                       const bool held = false, const mpm::ElasticLaw law = mpm::ElasticLaw::jaumann_rate)
   {
     using namespace mpm;
     const double h = 0.005, rho = 2650, E = 0.84e6, nu = 0.3, g = 9.81;
@@ -133,6 +143,7 @@ namespace mpm_test
         m.drucker_prager.strength.friction_angle  = 19.8 * 3.14159265358979323846 / 180;
         m.drucker_prager.strength.residual_friction_angle = m.drucker_prager.strength.friction_angle;
       }
+    m.elastic_law  = law;
     const double c = std::sqrt(m.elastic.p_wave_modulus() / rho);
 
     StepSettings<2, double> s;
@@ -150,7 +161,7 @@ namespace mpm_test
         s.flip_fraction = 0;
       }
     Target<2, double> target(grid, points, {m});
-    return step_scene<2>(target, s, cfl, h, c, n_steps);
+    return step_scene<2>(target, s, cfl, h, c, n_steps, law == ElasticLaw::hencky);
   }
 
   // The slide: frictional walls (wall_friction.h) on the base and on the wall it runs into.

@@ -264,6 +264,40 @@ namespace mpm
 #  endif
 #endif
   }
+
+  // The same nodes, weights and gradients as for_each_stencil_node, each with the node's offset
+  // from the point, r = x_i - x_p: visit(node, N, grad, r). The affine transfers' momentum and
+  // APIC's B_p read it (step.h); host and device, the offsets computed as HostStencil's.
+  template <int dim, typename Shape, typename Real, typename Visitor>
+  MPM_HOST_DEVICE inline void for_each_stencil_node_with_offset(const GridView<dim, Real> &grid, const Real x[dim],
+                                                                const Real half_length[dim], Visitor &&visit)
+  {
+    constexpr int n = Shape::n_per_direction;
+    int           first[dim];
+    Real          w[dim][n], dw[dim][n];
+    const Real    inv_h = Real(1) / grid.h;
+    for (int d = 0; d < dim; ++d)
+      stencil_weights_1d<Shape>((x[d] - grid.origin[d]) * inv_h, half_length[d] * inv_h, grid.n_cells[d], first[d], w[d],
+                                dw[d]);
+    constexpr int n_stencil = dim == 2 ? n * n : n * n * n;
+    for (int s = 0; s < n_stencil; ++s)
+      {
+        const int k[3] = {s % n, (s / n) % n, s / (n * n)};
+        int       idx[dim];
+        Real      offset[dim];
+        for (int d = 0; d < dim; ++d)
+          {
+            idx[d]    = first[d] + k[d];
+            offset[d] = grid.origin[d] + grid.h * idx[d] - x[d];
+          }
+        const int node = grid.node(idx);
+        if (node < 0)
+          continue;
+        Real       grad[dim];
+        const Real N = stencil_weight<dim, n>(w, dw, inv_h, k, grad);
+        visit(node, N, static_cast<const Real *>(grad), static_cast<const Real *>(offset));
+      }
+  }
 } // namespace mpm
 
 #undef MPM_UNROLL

@@ -41,6 +41,29 @@ namespace mpm
                            // weights it equals the gradient form; GIMP has no constant D_p (refused)
   };
 
+  // What the device's kernels compile (explicit_step's template argument). The affine
+  // transfers and Hencky's law cost every launch registers and time where compiled in (Hencky
+  // alone: 4% of P1's step on the H100, doc/log.md), so the device compiles them only into a
+  // second variant of the step, run where a run asks for them (DeviceEngine). Host code
+  // compiles everything either way.
+  enum class DevicePhysics : int
+  {
+    standard = 0, // the FLIP/PIC blend and the Jaumann rate form
+    all      = 1  // also the affine transfers (TPIC, APIC) and Hencky's law
+  };
+
+  // Whether the code being compiled holds the affine transfers and Hencky's law: always on the
+  // host, on the device where the step's variant asks for them.
+  template <DevicePhysics physics>
+  MPM_HOST_DEVICE constexpr bool all_physics_compiled()
+  {
+#if defined(__CUDA_ARCH__)
+    return physics == DevicePhysics::all;
+#else
+    return true;
+#endif
+  }
+
   template <int dim, typename Real>
   struct StepSettings
   {
@@ -71,8 +94,8 @@ namespace mpm
     // carries an affine velocity matrix C_p (dim x dim, row-major) in
     // p.state_variables[affine_state_variable + a dim + b], its momentum reaches the grid as
     // m N_i (v_p + C_p (x_i - x_p)), and G2P gives PIC's velocity and C_p (affine_matrix_of).
-    // flip_fraction must be 0. -1: neither. Host backends whose stages use HostStencil only
-    // (the CPU's; explicit_step refuses the others).
+    // flip_fraction must be 0. -1: neither. On the device the step's kernels must hold them
+    // (explicit_step<..., DevicePhysics::all>; explicit_step refuses the standard ones).
     int          affine_state_variable = -1;
     AffineMatrix affine_matrix         = AffineMatrix::velocity_gradient;
     // A body acceleration of each point's own, added to gravity in P2G: dim state variables
@@ -242,7 +265,7 @@ namespace mpm
 
     // APIC's D_p / h^2 for a shape function (Jiang et al. 2015), 0 where it has none constant.
     template <typename Shape>
-    constexpr double apic_inertia_over_h2()
+    MPM_HOST_DEVICE constexpr double apic_inertia_over_h2()
     {
       if constexpr (std::is_same_v<Shape, QuadraticBSplineShape>)
         return 0.25;
@@ -252,7 +275,24 @@ namespace mpm
         return 0;
     }
 
-#if !defined(__CUDA_ARCH__) && !defined(MPM_UNROLL_STENCIL)
+    // A point's stencil visited with the weights evaluated on each visit (the device's form,
+    // for_each_stencil_node), with the interface of HostStencil that the affine transfers use.
+    template <int dim, typename Shape, typename Real>
+    struct PointStencil
+    {
+      const Real *x, *half_length;
+      template <typename Visitor>
+      MPM_HOST_DEVICE void for_each(const GridView<dim, Real> &g, Visitor &&visit) const
+      {
+        for_each_stencil_node<dim, Shape>(g, x, half_length, visit);
+      }
+      template <typename Visitor>
+      MPM_HOST_DEVICE void for_each_with_offset(const GridView<dim, Real> &g, const Real *, Visitor &&visit) const
+      {
+        for_each_stencil_node_with_offset<dim, Shape>(g, x, half_length, visit);
+      }
+    };
+
     // The affine matrix of a point from the nodal velocities v_i (`nodal`).
     // TPIC, the gradient form C = sum_i v_i grad N_i^T: exact for affine fields v = A x + b
     // wherever the weights reproduce linear fields (sum (A x_i + b) grad N_i^T = A), any shape.
@@ -261,11 +301,12 @@ namespace mpm
     // (there the folded weights give a smaller sum, and C is damped towards 0, never amplified).
     // A D_p computed from each stencil instead turns nearly singular at the faces (the V3
     // collapse blew up at 0.48 s with it, doc/log.md). Linear weights: APIC's B D^-1 is the
-    // gradient form (Jiang et al.), which is what is computed.
-    template <int dim, typename Shape, typename Real>
-    inline void affine_matrix_of(const GridView<dim, Real> &g, Real *const *nodal,
-                                 const HostStencil<dim, Shape, Real> &stencil, const Real x[dim],
-                                 const AffineMatrix form, Real C[dim * dim])
+    // gradient form (Jiang et al.), which is what is computed. Stencil: HostStencil on the
+    // host, PointStencil on the device.
+    template <int dim, typename Shape, typename Real, typename Stencil>
+    MPM_HOST_DEVICE inline void affine_matrix_of(const GridView<dim, Real> &g, Real *const *nodal,
+                                                 const Stencil &stencil, const Real x[dim], const AffineMatrix form,
+                                                 Real C[dim * dim])
     {
       for (int k = 0; k < dim * dim; ++k)
         C[k] = Real(0);
@@ -287,10 +328,12 @@ namespace mpm
       });
     }
 
-    // The affine part of a point's momentum into its stencil: m N_i C (x_i - x_p).
-    template <typename Backend, int dim, typename Shape, typename Real>
-    inline void add_apic_momentum(const GridView<dim, Real> &g, const HostStencil<dim, Shape, Real> &stencil,
-                                  const Real x[dim], const Real m, const Real C[dim * dim])
+    // The affine part of a point's momentum into its stencil: m N_i C (x_i - x_p). On the
+    // device one atomicAdd per value: the kernels that call it hold scatter_stencil's shared
+    // records already, and add_to_node's staging area does not fit beside them.
+    template <typename Backend, int dim, typename Real, typename Stencil>
+    MPM_HOST_DEVICE inline void add_apic_momentum(const GridView<dim, Real> &g, const Stencil &stencil,
+                                                  const Real x[dim], const Real m, const Real C[dim * dim])
     {
       Real *targets[dim];
       for (int d = 0; d < dim; ++d)
@@ -304,29 +347,34 @@ namespace mpm
               cr += C[a * dim + b] * r[b];
             values[a] = m * N * cr;
           }
+#if defined(__CUDA_ARCH__)
+        for (int a = 0; a < dim; ++a)
+          atomicAdd(&targets[a][n], values[a]);
+#else
         Backend::template add_to_node<dim>(targets, n, values);
+#endif
       });
     }
 
     template <int dim, typename Real>
-    inline void load_affine(const PointsView<dim, Real> &p, const StepSettings<dim, Real> &s, const int i,
-                            Real C[dim * dim])
+    MPM_HOST_DEVICE inline void load_affine(const PointsView<dim, Real> &p, const StepSettings<dim, Real> &s,
+                                            const int i, Real C[dim * dim])
     {
       for (int k = 0; k < dim * dim; ++k)
         C[k] = p.state_variables[s.affine_state_variable + k][i];
     }
 
     template <int dim, typename Real>
-    inline void store_affine(const PointsView<dim, Real> &p, const StepSettings<dim, Real> &s, const int i,
-                             const Real C[dim * dim])
+    MPM_HOST_DEVICE inline void store_affine(const PointsView<dim, Real> &p, const StepSettings<dim, Real> &s,
+                                             const int i, const Real C[dim * dim])
     {
       for (int k = 0; k < dim * dim; ++k)
         p.state_variables[s.affine_state_variable + k][i] = C[k];
     }
-#endif
 
     // P2G: nodal mass and momentum, and/or internal (-V sigma . grad N) and gravity forces.
-    template <int dim, typename Shape, typename Real, typename Backend>
+    template <int dim, typename Shape, DevicePhysics physics = DevicePhysics::standard, typename Real,
+              typename Backend>
     void particles_to_grid(Backend                          &backend,
                            const GridView<dim, Real>        &g,
                            const PointsView<dim, Real>      &p,
@@ -418,14 +466,17 @@ namespace mpm
               }
             scatter(force, targets + dim + 1);
           }
-#if !defined(__CUDA_ARCH__) && !defined(MPM_UNROLL_STENCIL)
-        if (mass_and_momentum && s.affine_state_variable >= 0)
-          {
-            Real C[dim * dim];
-            load_affine(p, s, i, C);
-            add_apic_momentum<Backend>(g, stencil, x, m, C);
-          }
+        if constexpr (all_physics_compiled<physics>())
+          if (mass_and_momentum && s.affine_state_variable >= 0)
+            {
+              Real C[dim * dim];
+              load_affine(p, s, i, C);
+#if defined(__CUDA_ARCH__) || defined(MPM_UNROLL_STENCIL)
+              add_apic_momentum<Backend, dim>(g, PointStencil<dim, Shape, Real>{x, lp}, x, m, C);
+#else
+              add_apic_momentum<Backend, dim>(g, stencil, x, m, C);
 #endif
+            }
       });
     }
 
@@ -542,7 +593,8 @@ namespace mpm
     }
 
     // G2P velocity (USL, USF).
-    template <int dim, typename Shape, typename Real, typename Backend>
+    template <int dim, typename Shape, DevicePhysics physics = DevicePhysics::standard, typename Real,
+              typename Backend>
     void grid_to_particle_velocity(Backend &backend, const GridView<dim, Real> &g,
                                    const PointsView<dim, Real> &p, const StepSettings<dim, Real> &s)
     {
@@ -559,14 +611,18 @@ namespace mpm
           g, p, s, i, [&](auto &&visit) { for_each_stencil_node<dim, Shape>(g, x, lp, visit); }, v_new);
         for (int d = 0; d < dim; ++d)
           p.velocity[d][i] = v_new[d];
-#if !defined(__CUDA_ARCH__) && !defined(MPM_UNROLL_STENCIL)
-        if (s.affine_state_variable >= 0) // from v^{n+1}, which update_grid left in force[] (flip_fraction 0)
-          {
-            Real C[dim * dim];
-            affine_matrix_of<dim>(g, g.force, HostStencil<dim, Shape, Real>(g, x, lp), x, s.affine_matrix, C);
-            store_affine(p, s, i, C);
-          }
+        if constexpr (all_physics_compiled<physics>())
+          if (s.affine_state_variable >= 0) // from v^{n+1}, which update_grid left in force[] (flip_fraction 0)
+            {
+              Real C[dim * dim];
+#if defined(__CUDA_ARCH__) || defined(MPM_UNROLL_STENCIL)
+              affine_matrix_of<dim, Shape>(g, g.force, PointStencil<dim, Shape, Real>{x, lp}, x, s.affine_matrix, C);
+#else
+              affine_matrix_of<dim, Shape>(g, g.force, HostStencil<dim, Shape, Real>(g, x, lp), x, s.affine_matrix,
+                                           C);
 #endif
+              store_affine(p, s, i, C);
+            }
       });
     }
 
@@ -575,7 +631,8 @@ namespace mpm
     // one pass over the points, which reads each point once for both (the remap reads only
     // what the gather wrote and the grid's velocity and acceleration, which it does not
     // write).
-    template <int dim, typename Shape, typename Real, typename Backend>
+    template <int dim, typename Shape, DevicePhysics physics = DevicePhysics::standard, typename Real,
+              typename Backend>
     void grid_to_particle_velocity_and_remap(Backend &backend, const GridView<dim, Real> &g,
                                              const PointsView<dim, Real> &p, const StepSettings<dim, Real> &s,
                                              const void *stencils = nullptr)
@@ -617,16 +674,19 @@ namespace mpm
           }
 #if defined(__CUDA_ARCH__) || defined(MPM_UNROLL_STENCIL)
         Backend::template scatter_stencil<dim, Shape>(g, x, lp, targets, momentum);
+        const PointStencil<dim, Shape, Real> affine_stencil{x, lp};
 #else
         add_contribution<Backend>(stencil, targets, momentum);
-        if (s.affine_state_variable >= 0) // C from v^{n+1} (force[], flip_fraction 0), then its momentum
-          {
-            Real C[dim * dim];
-            affine_matrix_of<dim>(g, g.force, *host_stencil, x, s.affine_matrix, C);
-            store_affine(p, s, i, C);
-            add_apic_momentum<Backend>(g, *host_stencil, x, m, C);
-          }
+        const HostStencil<dim, Shape, Real> &affine_stencil = *host_stencil;
 #endif
+        if constexpr (all_physics_compiled<physics>())
+          if (s.affine_state_variable >= 0) // C from v^{n+1} (force[], flip_fraction 0), then its momentum
+            {
+              Real C[dim * dim];
+              affine_matrix_of<dim, Shape>(g, g.force, affine_stencil, x, s.affine_matrix, C);
+              store_affine(p, s, i, C);
+              add_apic_momentum<Backend, dim>(g, affine_stencil, x, m, C);
+            }
       });
     }
 
@@ -674,7 +734,8 @@ namespace mpm
     // A point whose centre leaves the grid is marked removed (material = -1).
     // The particle domain is rescaled only in the pass that moves the points, so that
     // every transfer of one step uses the same stencil (USF deforms before it moves).
-    template <int dim, typename Shape, typename Real, typename Backend>
+    template <int dim, typename Shape, DevicePhysics physics = DevicePhysics::standard, typename Real,
+              typename Backend>
     void grid_to_particle_kinematics(Backend &backend, const GridView<dim, Real> &g,
                                      const PointsView<dim, Real> &p,
                                      const MaterialParameters<Real> *materials,
@@ -779,9 +840,10 @@ namespace mpm
 #endif
             const MaterialParameters<Real> &material = materials[p.material[i]];
             if (material.field_parameter == FieldParameter::none)
-              update_stress(material, kinematics, state);
+              update_stress<all_physics_compiled<physics>()>(material, kinematics, state);
             else
-              update_stress(with_field_value(material, p.material_field[i]), kinematics, state);
+              update_stress<all_physics_compiled<physics>()>(with_field_value(material, p.material_field[i]),
+                                                             kinematics, state);
             for (int c = 0; c < n_voigt; ++c)
               {
                 p.stress[c][i] = state.stress[c];
@@ -931,7 +993,9 @@ namespace mpm
 
   // One step of the chosen scheme. Returns the reductions needed for the next time
   // step and for the time history.
-  template <int dim, typename Shape, typename Real, typename Backend, typename Exchange = NoGridExchange>
+  // physics: which physics the device's kernels hold (DevicePhysics); the host's hold all.
+  template <int dim, typename Shape, DevicePhysics physics = DevicePhysics::standard, typename Real, typename Backend,
+            typename Exchange = NoGridExchange>
   StepReduction<Real> explicit_step(Backend &backend, const GridView<dim, Real> &g,
                                     const PointsView<dim, Real> &p,
                                     const MaterialParameters<Real> *materials,
@@ -941,13 +1005,9 @@ namespace mpm
     using namespace stages;
     if (s.affine_state_variable >= 0)
       {
-#if defined(MPM_UNROLL_STENCIL)
-        constexpr bool host_stencils = false;
-#else
-        constexpr bool host_stencils = !atomic_scatter<Backend>::value;
-#endif
-        if (!host_stencils)
-          throw std::invalid_argument("explicit_step: APIC runs on the CPU backend only");
+        if (atomic_scatter<Backend>::value && physics != DevicePhysics::all)
+          throw std::invalid_argument("explicit_step: the affine transfers need the device's kernels compiled with "
+                                      "them (explicit_step<dim, Shape, DevicePhysics::all>)");
         if (s.flip_fraction != Real(0))
           throw std::invalid_argument("explicit_step: APIC needs flip_fraction = 0 (its velocity is PIC's)");
         if (p.n_state_variables < s.affine_state_variable + dim * dim)
@@ -1009,14 +1069,14 @@ namespace mpm
               stencils = backend.point_scratch(p.n_points, sizeof(HostStencil<dim, Shape, Real>));
 #endif
             reset_grid(backend, g, true, s.pressure_averaging && !apply_pending);
-            particles_to_grid<dim, Shape>(backend, g, p, s, true, true, stencils, apply_pending);
+            particles_to_grid<dim, Shape, physics>(backend, g, p, s, true, true, stencils, apply_pending);
             exchange.sum_nodal(p2g_sums, 2 * dim + 1);
             update_grid(backend, g, s, dt, true, apply_pending);
-            grid_to_particle_velocity_and_remap<dim, Shape>(backend, g, p, s, stencils);
+            grid_to_particle_velocity_and_remap<dim, Shape, physics>(backend, g, p, s, stencils);
             exchange.sum_nodal(momentum, dim);
             if (!s.hold_points || s.hold_from_point_momentum) // held, the grid keeps its updated ones
               velocity_from_momentum(backend, g, s.mass_tolerance);
-            grid_to_particle_kinematics<dim, Shape>(backend, g, p, materials, s, dt, true, true, stencils,
+            grid_to_particle_kinematics<dim, Shape, physics>(backend, g, p, materials, s, dt, true, true, stencils,
                                                     scatter_in_kinematics);
           }
           scatter_averaged_pressure();
@@ -1024,29 +1084,29 @@ namespace mpm
 
         case UpdateScheme::usl:
           reset_grid(backend, g, true, s.pressure_averaging && !apply_pending);
-          particles_to_grid<dim, Shape>(backend, g, p, s, true, true, nullptr, apply_pending);
+          particles_to_grid<dim, Shape, physics>(backend, g, p, s, true, true, nullptr, apply_pending);
           exchange.sum_nodal(p2g_sums, 2 * dim + 1);
           update_grid(backend, g, s, dt, false, apply_pending);
-          grid_to_particle_velocity<dim, Shape>(backend, g, p, s);
-          grid_to_particle_kinematics<dim, Shape>(backend, g, p, materials, s, dt, true, true, nullptr,
+          grid_to_particle_velocity<dim, Shape, physics>(backend, g, p, s);
+          grid_to_particle_kinematics<dim, Shape, physics>(backend, g, p, materials, s, dt, true, true, nullptr,
                                                   scatter_in_kinematics);
           scatter_averaged_pressure();
           break;
 
         case UpdateScheme::usf:
           reset_grid(backend, g, true);
-          particles_to_grid<dim, Shape>(backend, g, p, s, true, false);
+          particles_to_grid<dim, Shape, physics>(backend, g, p, s, true, false);
           exchange.sum_nodal(mass_and_momentum, dim + 1);
           if (!s.hold_points || s.hold_from_point_momentum) // held, the last step's grid velocities
             velocity_from_momentum(backend, g, s.mass_tolerance);
-          grid_to_particle_kinematics<dim, Shape>(backend, g, p, materials, s, dt, false, true);
+          grid_to_particle_kinematics<dim, Shape, physics>(backend, g, p, materials, s, dt, false, true);
           if (s.pressure_averaging)
             average_cell_pressure(backend, g, p, exchange);
-          particles_to_grid<dim, Shape>(backend, g, p, s, false, true);
+          particles_to_grid<dim, Shape, physics>(backend, g, p, s, false, true);
           exchange.sum_nodal(forces, dim);
           update_grid(backend, g, s, dt);
-          grid_to_particle_velocity<dim, Shape>(backend, g, p, s);
-          grid_to_particle_kinematics<dim, Shape>(backend, g, p, materials, s, dt, true, false);
+          grid_to_particle_velocity<dim, Shape, physics>(backend, g, p, s);
+          grid_to_particle_kinematics<dim, Shape, physics>(backend, g, p, materials, s, dt, true, false);
           break;
       }
     if constexpr (colours_scatter<Backend>::value)
@@ -1065,7 +1125,8 @@ namespace mpm
   }
 
   // Dispatch on the shape function chosen at run time.
-  template <int dim, typename Real, typename Backend, typename Exchange = NoGridExchange>
+  template <int dim, DevicePhysics physics = DevicePhysics::standard, typename Real, typename Backend,
+            typename Exchange = NoGridExchange>
   StepReduction<Real> explicit_step(Backend &backend, const ShapeFunction shape,
                                     const GridView<dim, Real> &g, const PointsView<dim, Real> &p,
                                     const MaterialParameters<Real> *materials,
@@ -1073,11 +1134,11 @@ namespace mpm
                                     const Exchange &exchange = Exchange(), bool *averaging_pending = nullptr)
   {
     if (shape == ShapeFunction::gimp)
-      return explicit_step<dim, GimpShape>(backend, g, p, materials, s, dt, exchange, averaging_pending);
+      return explicit_step<dim, GimpShape, physics>(backend, g, p, materials, s, dt, exchange, averaging_pending);
     if (shape == ShapeFunction::bspline2)
-      return explicit_step<dim, QuadraticBSplineShape>(backend, g, p, materials, s, dt, exchange, averaging_pending);
+      return explicit_step<dim, QuadraticBSplineShape, physics>(backend, g, p, materials, s, dt, exchange, averaging_pending);
     if (shape == ShapeFunction::bspline3)
-      return explicit_step<dim, CubicBSplineShape>(backend, g, p, materials, s, dt, exchange, averaging_pending);
-    return explicit_step<dim, LinearShape>(backend, g, p, materials, s, dt, exchange, averaging_pending);
+      return explicit_step<dim, CubicBSplineShape, physics>(backend, g, p, materials, s, dt, exchange, averaging_pending);
+    return explicit_step<dim, LinearShape, physics>(backend, g, p, materials, s, dt, exchange, averaging_pending);
   }
 } // namespace mpm

@@ -92,6 +92,9 @@ namespace mpm
       void download_nodal(const GridView<dim, double> &host_grid) const;
 
       // One step on the device; only the reduction (max speed, power of gravity) comes back.
+      // The affine transfers (settings.affine_state_variable: the uploaded points hold the
+      // matrices) and a material with Hencky's law run the step's second variant of kernels
+      // (DevicePhysics::all, step.h); everything else the standard one.
       StepReduction<double> step(const StepSettings<dim, double> &settings, double dt);
       PointTotals<dim, double> totals();
       void set_materials(const std::vector<MaterialParameters<double>> &materials);

@@ -141,6 +141,8 @@ namespace mpm
       const int n = points.size();
       if (static_cast<int>(original.size()) != n)
         throw std::logic_error("PointOrder::download_in_reference_order: the order was not reset for these points");
+      if (host.n_state_variables() < points.n_state_variables())
+        host.set_n_state_variables(points.n_state_variables());
       for_each_point_array<dim>(points, host, [&](const auto &device, auto &out) {
         auto &scratch = scratch_for(device);
         scratch.resize(n);

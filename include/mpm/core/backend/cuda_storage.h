@@ -120,20 +120,27 @@ namespace mpm
       deformation_gradient[dim * dim], domain_half_length[dim], initial_domain_half_length[dim], plastic_strain,
       material_field;
     DeviceArray<int> material;
+    // The affine transfers' matrices (StepSettings::affine_state_variable): as many arrays as
+    // the uploaded points hold, none unless the run uses TPIC or APIC.
+    std::vector<DeviceArray<Real>> state_variables;
 
     int size() const { return static_cast<int>(mass.size()); }
+    int n_state_variables() const { return static_cast<int>(state_variables.size()); }
 
     void upload(const HostPoints<dim, Real> &h)
     {
+      state_variables.resize(h.state_variables.size());
       for_each_point_array<dim>(*this, h, [](auto &device, const auto &host) { device.upload(host); });
     }
 
     void download(HostPoints<dim, Real> &h) const
     {
+      if (h.n_state_variables() < n_state_variables())
+        h.set_n_state_variables(n_state_variables());
       for_each_point_array<dim>(*this, h, [](const auto &device, auto &host) { device.download(host); });
     }
 
-    // Bytes of device memory held per point.
+    // Bytes of device memory held per point, without state variables.
     static constexpr size_t bytes_per_point()
     {
       return (4 * dim + 5 + 2 * n_voigt + dim * dim) * sizeof(Real) + sizeof(int);

@@ -45,8 +45,9 @@ namespace mpm
     // at which plasticity is switched on); eps_p is then left unchanged.
     bool plasticity_enabled = true;
     FieldParameter field_parameter = FieldParameter::none;
-    // The elastic part's form (hencky.h); built-in models only. Hencky is compiled for the
-    // CPU backend only for now: the device's kernels keep the Jaumann rate.
+    // The elastic part's form (hencky.h); built-in models only. The device compiles Hencky's law
+    // only into the step's DevicePhysics::all variant (step.h), which DeviceEngine runs where a
+    // material asks for it.
     ElasticLaw elastic_law = ElasticLaw::jaumann_rate;
     // model == user_defined: the model (host memory; owned by the material library).
     const UserConstitutiveModel *user_model = nullptr;
@@ -91,8 +92,11 @@ namespace mpm
   }
 
   // The update of a point that knows its whole motion over the step (the MPM step): the
-  // material's elastic law picks the Jaumann rate form or Hencky's.
-  template <typename Real>
+  // material's elastic law picks the Jaumann rate form or Hencky's. with_hencky = false leaves
+  // Hencky's law out of the compiled code (the device's standard kernels, step.h's
+  // DevicePhysics): every material then runs the Jaumann rate form, and the caller must have
+  // made sure none asks for Hencky.
+  template <bool with_hencky = true, typename Real>
   MPM_HOST_DEVICE inline void update_stress(const MaterialParameters<Real> &m, const StepKinematics<Real> &k,
                                             MaterialPointState<Real> &state);
 
@@ -128,38 +132,39 @@ namespace mpm
       }
   }
 
-  template <typename Real>
+  template <bool with_hencky, typename Real>
   MPM_HOST_DEVICE inline void update_stress(const MaterialParameters<Real> &m, const StepKinematics<Real> &k,
                                             MaterialPointState<Real> &state)
   {
-#ifndef __CUDA_ARCH__
-    if (m.elastic_law == ElasticLaw::hencky && m.model != MaterialModel::user_defined)
+    if constexpr (with_hencky)
       {
-        switch (m.model)
+        if (m.elastic_law == ElasticLaw::hencky && m.model != MaterialModel::user_defined)
           {
-            case MaterialModel::drucker_prager:
-              hencky_update(m.elastic, m.plasticity_enabled, k, state.stress, state.plastic_strain,
-                            [&](SymTensor<Real> &tau, const Real eps_p) {
-                              return drucker_prager_return(m.elastic,
-                                                           drucker_prager_coefficients_at(m.drucker_prager, eps_p),
-                                                           tau);
-                            });
-              break;
-            case MaterialModel::mohr_coulomb:
-              hencky_update(m.elastic, m.plasticity_enabled, k, state.stress, state.plastic_strain,
-                            [&](SymTensor<Real> &tau, const Real eps_p) {
-                              return mohr_coulomb_return(m.elastic, current_strength(m.mohr_coulomb.strength, eps_p),
-                                                         tau);
-                            });
-              break;
-            default:
-              hencky_update(m.elastic, false, k, state.stress, state.plastic_strain,
-                            [](SymTensor<Real> &, const Real) { return elastic_return<Real>(); });
-              break;
+            switch (m.model)
+              {
+                case MaterialModel::drucker_prager:
+                  hencky_update(m.elastic, m.plasticity_enabled, k, state.stress, state.plastic_strain,
+                                [&](SymTensor<Real> &tau, const Real eps_p) {
+                                  return drucker_prager_return(m.elastic,
+                                                               drucker_prager_coefficients_at(m.drucker_prager, eps_p),
+                                                               tau);
+                                });
+                  break;
+                case MaterialModel::mohr_coulomb:
+                  hencky_update(m.elastic, m.plasticity_enabled, k, state.stress, state.plastic_strain,
+                                [&](SymTensor<Real> &tau, const Real eps_p) {
+                                  return mohr_coulomb_return(m.elastic, current_strength(m.mohr_coulomb.strength, eps_p),
+                                                             tau);
+                                });
+                  break;
+                default:
+                  hencky_update(m.elastic, false, k, state.stress, state.plastic_strain,
+                                [](SymTensor<Real> &, const Real) { return elastic_return<Real>(); });
+                  break;
+              }
+            return;
           }
-        return;
       }
-#endif
     update_stress(m, k.d_eps, k.d_spin, state);
   }
 } // namespace mpm
