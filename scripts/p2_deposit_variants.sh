@@ -26,7 +26,15 @@ declare -A solver=(
   [no_averaging]="set Pressure averaging = false"
   [cpgimp_u_no_damping]="set GIMP domain update = U
   set Local damping = 0"
+  [tpic_no_damping]="set Velocity transfer = TPIC
+  set Local damping = 0"
+  [apic_bspline2_no_damping]="set Shape function = quadratic B-spline
+  set Velocity transfer = APIC
+  set Local damping = 0"
+  [cpgimp_u_hencky_no_damping]="set GIMP domain update = U
+  set Local damping = 0"
 )
+declare -A material=([cpgimp_u_hencky_no_damping]="set Elastic law = Hencky")
 declare -A boundary=([free_slip_base]="set z min = free-slip")
 all="default no_damping cpgimp_u cpgimp_f_ii cpgimp_det_f bspline2 flip_1 no_averaging free_slip_base cpgimp_u_no_damping"
 [ $# -gt 0 ] && all="$*"
@@ -40,6 +48,9 @@ for name in $all; do
     echo "end"
     echo "subsection Boundary conditions"
     echo "  ${boundary[$name]:-}"
+    echo "end"
+    echo "subsection Material points"
+    echo "  ${material[$name]:-}"
     echo "end"
     echo "subsection Output"
     echo "  set Directory = $dir"
