@@ -49,7 +49,7 @@ for name in $all; do
     echo "subsection Boundary conditions"
     echo "  ${boundary[$name]:-}"
     echo "end"
-    echo "subsection Material points"
+    echo "subsection Material aluminium bars"
     echo "  ${material[$name]:-}"
     echo "end"
     echo "subsection Output"

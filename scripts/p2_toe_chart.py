@@ -19,7 +19,7 @@ source = sys.argv[1] if len(sys.argv) > 1 else os.path.join(root, "doc", "p2_toe
 target = sys.argv[2] if len(sys.argv) > 2 else os.path.join(root, "doc", "figures", "p2_toe.png")
 rows = list(csv.DictReader(open(source)))
 
-fig, ax = plt.subplots(figsize=(8, 0.42 * len(rows) + 1.4))
+fig, ax = plt.subplots(figsize=(9, 0.42 * len(rows) + 1.4))
 ax.axvspan(0.42, 0.45, color="tab:green", alpha=0.2, label="experiment (Bui et al. 2008), 0.42-0.45 m")
 ax.axvline(0.441, color="tab:purple", linestyle="--", label="ep2-3De on the same scene, 0.441 m")
 for k, r in enumerate(rows):
@@ -33,10 +33,14 @@ for k, r in enumerate(rows):
     ax.text(min(toe, 0.595) + 0.002, y, f"{toe:.3f} m, top-left {float(r['top_left_m']):.4f} m, {r['wall_s']} s",
             va="center", fontsize=7)
 ax.set_yticks(range(len(rows)))
-ax.set_yticklabels([r["variant"] for r in reversed(rows)], fontsize=8)
+# Rows from another machine than the first row's are marked with it (timings compare within one machine).
+def label(r):
+    return r["variant"] + ("" if r["machine"] == rows[0]["machine"] else " (" + r["machine"].split("(")[0].strip() + ")")
+ax.set_yticklabels([label(r) for r in reversed(rows)], fontsize=8)
 ax.set_xlim(0.35, 0.68)
 ax.set_xlabel("toe: 99.9th percentile of x at t = 1 s (m)")
-ax.set_title(f"P2, 512,000 points, Backend = cuda: the toe against the method\n({rows[0]['machine']}, {rows[0]['date']})",
+ax.set_title(f"P2, 512,000 points, Backend = cuda: the toe against the method\n({rows[0]['machine']}, {rows[0]['date']}; "
+             f"marked rows: {rows[-1]['machine'].split('(')[0].strip()}, {rows[-1]['date']})",
              fontsize=9)
 ax.legend(loc="lower right", fontsize=7)
 fig.tight_layout()
