@@ -1,7 +1,8 @@
 #!/bin/bash
 # Backend = cuda on 1, 2 and 4 MPI ranks (one GPU per rank; ranks beyond a node's GPUs
 # share them). The scenes and assertions of the CPU's MPI tests: the reduced 2D V3 collapse
-# (mpi_collapse.sh) and the 3D collapse with pressure averaging (mpi_collapse_3d.sh), final
+# (mpi_collapse.sh; also with APIC, the quadratic B-spline and Hencky's law, and that on 1 rank
+# against the CPU) and the 3D collapse with pressure averaging (mpi_collapse_3d.sh), final
 # positions and stresses np-invariant to 1e-10 of the field's magnitude, points migrating
 # and the grid repartitioned on 4 ranks. Then the 3D scene on 2 ranks, cuda against cpu,
 # per point to the same 1e-10 (no local damping: round-off stays round-off).
@@ -22,6 +23,15 @@ export MPM_VERIFY_DRIFT_BOUND=1
 cuda=("subsection Backend" "  set Backend = cuda" "end")
 echo "== 2D collapse, cuda, 1 2 4 ranks"
 bash "$here/mpi_collapse.sh" "$exe" "$src" "$out/collapse-2d" "${cuda[@]}"
+echo "== 2D collapse with APIC on the quadratic B-spline and Hencky's law, cuda, 1 2 4 ranks"
+# The step's second variant of kernels (DevicePhysics::all); the affine matrices migrate with the points.
+affine=("subsection Solver" "  set Shape function = quadratic B-spline" "  set Velocity transfer = APIC" "end"
+        "subsection Material aluminium bars" "  set Elastic law = Hencky" "end")
+bash "$here/mpi_collapse.sh" "$exe" "$src" "$out/collapse-2d-affine" "${affine[@]}" "${cuda[@]}"
+echo "== the same on 1 rank: cpu against cuda"
+bash "$here/run_np.sh" "$exe" "$here/collapse_small_2d.prm" "$out/collapse-2d-affine-cpu" "1" \
+  "subsection Parallel" "  set Load balance threshold = 1.02" "end" "${affine[@]}"
+"$py" "$here/compare_np.py" "$out/collapse-2d-affine-cpu/np1" "$out/collapse-2d-affine/np1" --rtol 1e-10
 echo "== 3D collapse with pressure averaging, cuda, 1 2 4 ranks"
 bash "$here/mpi_collapse_3d.sh" "$exe" "$src" "$out/collapse-3d" "${cuda[@]}"
 echo "== 3D collapse on 2 ranks: cpu against cuda"
