@@ -1,5 +1,6 @@
 #include <mpm/dealii/guards.h>
 #include <mpm/dealii/material_library.h>
+#include <mpm/dealii/method_choice.h>
 #include <mpm/dealii/parameters.h>
 
 #include <deal.II/base/exceptions.h>
@@ -8,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <sstream>
 
 namespace mpm
@@ -192,6 +194,23 @@ namespace mpm
                       "C = B D^-1 with the B-splines' constant D (h^2/4 quadratic, h^2/3 cubic), equal to TPIC's "
                       "for linear; it needs Shape function = linear, quadratic B-spline or cubic B-spline. Both "
                       "backends. C starts at zero.");
+    prm.declare_entry("Method", "as set", Patterns::Selection("as set|auto"),
+                      "as set: Shape function, GIMP domain update, FLIP fraction, Velocity transfer and the "
+                      "materials' Elastic law as given. auto: the program sets them to the cheapest method of its "
+                      "method study (doc/methods.md) whose error, measured on the study's scene of the kind that "
+                      "Method scene names at the same resolution (cells across the bodies' largest extent), is at "
+                      "most Method tolerance; the log says what it picked and why. The scene's other settings "
+                      "(damping, pressure averaging, update scheme) stay as given.");
+    prm.declare_entry("Method scene", "run-out", Patterns::Selection("run-out|compression|bending|large stretch"),
+                      "Method = auto: the study's scene whose errors stand for this one. run-out: the granular "
+                      "collapse V3 (error: r.m.s. of the relative errors of toe, top-left height and slope against "
+                      "the experiment); compression: the elastic column V1 (stress norm); bending: the cantilever "
+                      "V2 (tip deflection); large stretch: the manufactured solution (L2 position error over the "
+                      "amplitude).");
+    prm.declare_entry("Method tolerance", "0.05", Patterns::Double(0),
+                      "Method = auto: the largest expected error, in the error measure of Method scene's scene "
+                      "(relative: 0.05 is 5%). If no method of the study is expected to reach it at the scene's "
+                      "resolution, the run stops and says what the most accurate method would give.");
     prm.declare_entry("Gravity", zeros(dim, -9.81), point_pattern(dim),
                       "Gravitational acceleration vector (m/s^2).");
     prm.declare_entry("Gravity ramp time", "0", Patterns::Double(0),
@@ -505,6 +524,11 @@ namespace mpm
                                        "Velocity transfer = TPIC.");
     if (apic)
       flip_fraction = 0; // APIC's velocity is PIC's plus the affine part
+    const bool        method_auto      = prm.get("Method") == "auto";
+    const std::string method_scene     = prm.get("Method scene");
+    const double      method_tolerance = prm.get_double("Method tolerance");
+    if (method_auto && !(method_tolerance > 0))
+      fail("Solver/Method tolerance", "must be > 0 with Method = auto, got " + prm.get("Method tolerance") + ".");
     gravity           = get_point(prm, "Gravity", "Solver/");
     gravity_ramp_time = prm.get_double("Gravity ramp time");
     max_steps         = prm.get_integer("Maximum number of steps");
@@ -665,6 +689,9 @@ namespace mpm
 
     prm.enter_subsection("Material points");
     const unsigned int n_bodies = initial_state_source == "FEM file" ? 0 : prm.get_integer("Number of bodies");
+    // The bodies' bounding box (Method = auto measures the resolution across it).
+    std::vector<double> bodies_lo(dim, std::numeric_limits<double>::max()),
+      bodies_hi(dim, std::numeric_limits<double>::lowest());
     for (unsigned int b = 1; b <= n_bodies; ++b)
       {
         const std::string where = "Material points/Body " + std::to_string(b) + "/";
@@ -735,6 +762,17 @@ namespace mpm
                                      dealii::Utilities::to_string(lower[d]) + ", " +
                                      dealii::Utilities::to_string(upper[d]) + "]).");
           }
+        if (body.shape == "cylinder")
+          for (unsigned int d = 0; d < 2; ++d)
+            {
+              lo[d] = body.axis[d] - body.radius;
+              hi[d] = body.axis[d] + body.radius;
+            }
+        for (unsigned int d = 0; d < dim; ++d)
+          {
+            bodies_lo[d] = std::min(bodies_lo[d], lo[d]);
+            bodies_hi[d] = std::max(bodies_hi[d], hi[d]);
+          }
         bodies.push_back(body);
         body_material.push_back(material_index);
       }
@@ -777,6 +815,41 @@ namespace mpm
     backend       = prm.get("Backend");
     sort_interval = prm.get_integer("Sort interval");
     prm.leave_subsection();
+
+    if (method_auto)
+      {
+        if (bodies.empty())
+          fail("Solver/Method", "auto measures the scene's resolution across its bodies (Material points/Body i); "
+                                "a scene whose points come from a FEM file has none: set the method (Method = as "
+                                "set).");
+        double extent = 0;
+        for (unsigned int d = 0; d < dim; ++d)
+          extent = std::max(extent, bodies_hi[d] - bodies_lo[d]);
+        bool hencky_allowed = true;
+        for (const MaterialParameters<double> &m : materials)
+          hencky_allowed = hencky_allowed && m.model != MaterialModel::user_defined;
+        MethodChoice choice;
+        try
+          {
+            choice = choose_method(method_scene, extent / cell_size, method_tolerance, backend == "cuda",
+                                   hencky_allowed, dim);
+          }
+        catch (const std::invalid_argument &e)
+          {
+            fail("Solver/Method tolerance", std::string(e.what()) + " Raise the tolerance, refine the grid (Grid/Cell "
+                                                                    "size), or set the method (Method = as set).");
+          }
+        const MethodSettings &m = choice.method;
+        shape_function          = m.shape;
+        domain_update           = m.domain_update;
+        apic                    = m.affine;
+        affine_matrix           = m.affine_matrix;
+        flip_fraction           = m.flip_fraction;
+        for (MaterialParameters<double> &material : materials)
+          if (material.model != MaterialModel::user_defined)
+            material.elastic_law = m.hencky ? ElasticLaw::hencky : ElasticLaw::jaumann_rate;
+        method_choice_report = choice.reason;
+      }
     if (backend == "cuda")
       for (unsigned int i = 0; i < materials.size(); ++i)
         {

@@ -172,6 +172,8 @@ namespace mpm
     State            &s          = *state;
     const Parameters &parameters = s.parameters;
     AssertThrow(!s.set_up, dealii::ExcMessage("Simulator::setup() was called twice."));
+    if (!parameters.method_choice_report.empty())
+      s.pcout << parameters.method_choice_report << "\n";
     s.h    = parameters.cell_size;
     if (given_bodies != nullptr)
       {

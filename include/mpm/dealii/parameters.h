@@ -67,6 +67,8 @@ namespace mpm
     // Solver/Velocity transfer = APIC or TPIC: an affine transfer, C_p in the last dim x dim state
     // variables, computed as affine_matrix says
     bool         apic          = false;
+    // Solver/Method = auto: the pick and why, for the log (empty: Method = as set)
+    std::string  method_choice_report;
     AffineMatrix affine_matrix = AffineMatrix::velocity_gradient;
     std::vector<double> gravity;
     double       gravity_ramp_time;
