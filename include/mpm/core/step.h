@@ -328,9 +328,11 @@ namespace mpm
       });
     }
 
-    // The affine part of a point's momentum into its stencil: m N_i C (x_i - x_p). On the
-    // device one atomicAdd per value: the kernels that call it hold scatter_stencil's shared
-    // records already, and add_to_node's staging area does not fit beside them.
+    // The affine part of a point's momentum into its stencil: m N_i C (x_i - x_p). Host
+    // backends add it in P2G's own loop; atomic ones (the device) in a pass of its own
+    // (add_affine_momentum below), since add_to_node's staging area does not fit beside
+    // scatter_stencil's shared records in one kernel, and one atomicAdd per value instead
+    // cost TPIC's step 2.6x the blend's on P1 (doc/log.md).
     template <typename Backend, int dim, typename Real, typename Stencil>
     MPM_HOST_DEVICE inline void add_apic_momentum(const GridView<dim, Real> &g, const Stencil &stencil,
                                                   const Real x[dim], const Real m, const Real C[dim * dim])
@@ -347,12 +349,7 @@ namespace mpm
               cr += C[a * dim + b] * r[b];
             values[a] = m * N * cr;
           }
-#if defined(__CUDA_ARCH__)
-        for (int a = 0; a < dim; ++a)
-          atomicAdd(&targets[a][n], values[a]);
-#else
         Backend::template add_to_node<dim>(targets, n, values);
-#endif
       });
     }
 
@@ -466,17 +463,37 @@ namespace mpm
               }
             scatter(force, targets + dim + 1);
           }
-        if constexpr (all_physics_compiled<physics>())
+#if !defined(__CUDA_ARCH__) && !defined(MPM_UNROLL_STENCIL)
+        // Atomic backends: add_affine_momentum, after this pass.
+        if constexpr (!atomic_scatter<Backend>::value)
           if (mass_and_momentum && s.affine_state_variable >= 0)
             {
               Real C[dim * dim];
               load_affine(p, s, i, C);
-#if defined(__CUDA_ARCH__) || defined(MPM_UNROLL_STENCIL)
-              add_apic_momentum<Backend, dim>(g, PointStencil<dim, Shape, Real>{x, lp}, x, m, C);
-#else
               add_apic_momentum<Backend, dim>(g, stencil, x, m, C);
-#endif
             }
+#endif
+      });
+    }
+
+    // The affine part of every point's momentum, m N_i C_p (x_i - x_p), in a pass of its own:
+    // atomic backends (the device), after each P2G of the momentum (explicit_step). Its adds
+    // go through add_to_node, summed per warp where neighbouring points share a node.
+    template <int dim, typename Shape, typename Real, typename Backend>
+    void add_affine_momentum(Backend &backend, const GridView<dim, Real> &g, const PointsView<dim, Real> &p,
+                             const StepSettings<dim, Real> &s)
+    {
+      backend.scatter_points(p.n_points, [=] MPM_HOST_DEVICE(const int i) {
+        if (p.material[i] < 0)
+          return;
+        Real x[dim], lp[dim], C[dim * dim];
+        for (int d = 0; d < dim; ++d)
+          {
+            x[d]  = p.position[d][i];
+            lp[d] = p.domain_half_length[d][i];
+          }
+        load_affine(p, s, i, C);
+        add_apic_momentum<Backend, dim>(g, PointStencil<dim, Shape, Real>{x, lp}, x, p.mass[i], C);
       });
     }
 
@@ -685,7 +702,8 @@ namespace mpm
               Real C[dim * dim];
               affine_matrix_of<dim, Shape>(g, g.force, affine_stencil, x, s.affine_matrix, C);
               store_affine(p, s, i, C);
-              add_apic_momentum<Backend, dim>(g, affine_stencil, x, m, C);
+              if constexpr (!atomic_scatter<Backend>::value) // atomic backends: add_affine_momentum
+                add_apic_momentum<Backend, dim>(g, affine_stencil, x, m, C);
             }
       });
     }
@@ -1056,6 +1074,13 @@ namespace mpm
       group_for_scatter<dim, Shape>(backend, g, p); // the points have moved
       scatter_cell_pressure(backend, g, p, exchange);
     };
+    // Atomic backends add the affine transfers' momentum in a pass of its own, after each P2G of
+    // the momentum (add_affine_momentum).
+    auto affine_momentum = [&]() {
+      if constexpr (atomic_scatter<Backend>::value && physics == DevicePhysics::all)
+        if (s.affine_state_variable >= 0)
+          add_affine_momentum<dim, Shape>(backend, g, p, s);
+    };
     group_for_scatter<dim, Shape>(backend, g, p);
     switch (s.scheme)
       {
@@ -1070,9 +1095,11 @@ namespace mpm
 #endif
             reset_grid(backend, g, true, s.pressure_averaging && !apply_pending);
             particles_to_grid<dim, Shape, physics>(backend, g, p, s, true, true, stencils, apply_pending);
+            affine_momentum();
             exchange.sum_nodal(p2g_sums, 2 * dim + 1);
             update_grid(backend, g, s, dt, true, apply_pending);
             grid_to_particle_velocity_and_remap<dim, Shape, physics>(backend, g, p, s, stencils);
+            affine_momentum();
             exchange.sum_nodal(momentum, dim);
             if (!s.hold_points || s.hold_from_point_momentum) // held, the grid keeps its updated ones
               velocity_from_momentum(backend, g, s.mass_tolerance);
@@ -1085,6 +1112,7 @@ namespace mpm
         case UpdateScheme::usl:
           reset_grid(backend, g, true, s.pressure_averaging && !apply_pending);
           particles_to_grid<dim, Shape, physics>(backend, g, p, s, true, true, nullptr, apply_pending);
+          affine_momentum();
           exchange.sum_nodal(p2g_sums, 2 * dim + 1);
           update_grid(backend, g, s, dt, false, apply_pending);
           grid_to_particle_velocity<dim, Shape, physics>(backend, g, p, s);
@@ -1096,6 +1124,7 @@ namespace mpm
         case UpdateScheme::usf:
           reset_grid(backend, g, true);
           particles_to_grid<dim, Shape, physics>(backend, g, p, s, true, false);
+          affine_momentum();
           exchange.sum_nodal(mass_and_momentum, dim + 1);
           if (!s.hold_points || s.hold_from_point_momentum) // held, the last step's grid velocities
             velocity_from_momentum(backend, g, s.mass_tolerance);
