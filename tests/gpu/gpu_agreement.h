@@ -55,4 +55,15 @@ namespace mpm_test
     check_below(gpu.worst(), limit, what.c_str());
     check(gpu.removed_mismatch == 0, (std::string(scene) + ": same points removed").c_str());
   }
+
+  // Fraction of the points with accumulated plastic strain (a scene that is to exercise the
+  // plastic return checks it).
+  template <int dim>
+  double plastic_fraction(const mpm::HostPoints<dim, double> &p)
+  {
+    int yielded = 0;
+    for (int i = 0; i < p.size(); ++i)
+      yielded += p.plastic_strain[i] > 0;
+    return double(yielded) / p.size();
+  }
 } // namespace mpm_test

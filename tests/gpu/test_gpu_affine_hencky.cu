@@ -58,16 +58,6 @@ void spin_agreement(const char *method, const DomainUpdate update, const Transfe
     }
 }
 
-// Fraction of the points with accumulated plastic strain.
-template <int dim>
-double plastic_fraction(const HostPoints<dim, double> &p)
-{
-  int yielded = 0;
-  for (int i = 0; i < p.size(); ++i)
-    yielded += p.plastic_strain[i] > 0;
-  return double(yielded) / p.size();
-}
-
 int main()
 {
   if (!cuda_device_present("test_gpu_affine_hencky"))

@@ -99,16 +99,6 @@ void spin_agreement(const bool cubic = false)
   report<dim>((scene + ", GPU sorted every 7").c_str(), compare_points(cpu, gpu, 0.125), spread, n, false);
 }
 
-// Fraction of the points with accumulated plastic strain.
-template <int dim>
-double plastic_fraction(const HostPoints<dim, double> &p)
-{
-  int yielded = 0;
-  for (int i = 0; i < p.size(); ++i)
-    yielded += p.plastic_strain[i] > 0;
-  return double(yielded) / p.size();
-}
-
 int main()
 {
   if (!cuda_device_present("test_gpu_cpu_agreement"))

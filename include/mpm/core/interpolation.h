@@ -82,6 +82,35 @@ namespace mpm
     return inside;
   }
 
+  // A stencil's nodes from its 1D weights, each with N, grad N and the node's offset from the
+  // point, r = x_i - x_p, as visit(node, N, grad, r): the affine transfers' momentum and APIC's
+  // B_p read it (step.h). Used by HostStencil::for_each_with_offset and
+  // for_each_stencil_node_with_offset.
+  template <int dim, int n, typename Real, typename Visitor>
+  MPM_HOST_DEVICE inline void visit_stencil_with_offset(const GridView<dim, Real> &grid, const int (&first)[dim],
+                                                        const Real (&w)[dim][n], const Real (&dw)[dim][n],
+                                                        const Real inv_h, const Real x[dim], Visitor &&visit)
+  {
+    constexpr int n_stencil = dim == 2 ? n * n : n * n * n;
+    for (int s = 0; s < n_stencil; ++s)
+      {
+        const int k[3] = {s % n, (s / n) % n, s / (n * n)};
+        int       idx[dim];
+        Real      offset[dim];
+        for (int d = 0; d < dim; ++d)
+          {
+            idx[d]    = first[d] + k[d];
+            offset[d] = grid.origin[d] + grid.h * idx[d] - x[d];
+          }
+        const int node = grid.node(idx);
+        if (node < 0)
+          continue; // outside the lattice: the weight is zero for points inside the grid
+        Real       grad[dim];
+        const Real N = stencil_weight<dim, n>(w, dw, inv_h, k, grad);
+        visit(node, N, static_cast<const Real *>(grad), static_cast<const Real *>(offset));
+      }
+  }
+
 #if !defined(__CUDA_ARCH__)
   // Host: one point's stencil, its 1D weights evaluated once (bit for bit as
   // for_each_stencil_node's), visited as often as a stage needs (G2P velocity and the
@@ -150,24 +179,7 @@ namespace mpm
     template <typename Visitor>
     void for_each_with_offset(const GridView<dim, Real> &grid, const Real x[dim], Visitor &&visit) const
     {
-      constexpr int n_stencil = dim == 2 ? n * n : n * n * n;
-      for (int s = 0; s < n_stencil; ++s)
-        {
-          const int k[3] = {s % n, (s / n) % n, s / (n * n)};
-          int       idx[dim];
-          Real      offset[dim];
-          for (int d = 0; d < dim; ++d)
-            {
-              idx[d]    = first[d] + k[d];
-              offset[d] = grid.origin[d] + grid.h * idx[d] - x[d];
-            }
-          const int node = grid.node(idx);
-          if (node < 0)
-            continue;
-          Real       grad[dim];
-          const Real N = stencil_weight<dim, n>(w, dw, inv_h, k, grad);
-          visit(node, N, grad, offset);
-        }
+      visit_stencil_with_offset<dim, n>(grid, first, w, dw, inv_h, x, visit);
     }
   };
 #endif
@@ -279,24 +291,7 @@ namespace mpm
     for (int d = 0; d < dim; ++d)
       stencil_weights_1d<Shape>((x[d] - grid.origin[d]) * inv_h, half_length[d] * inv_h, grid.n_cells[d], first[d], w[d],
                                 dw[d]);
-    constexpr int n_stencil = dim == 2 ? n * n : n * n * n;
-    for (int s = 0; s < n_stencil; ++s)
-      {
-        const int k[3] = {s % n, (s / n) % n, s / (n * n)};
-        int       idx[dim];
-        Real      offset[dim];
-        for (int d = 0; d < dim; ++d)
-          {
-            idx[d]    = first[d] + k[d];
-            offset[d] = grid.origin[d] + grid.h * idx[d] - x[d];
-          }
-        const int node = grid.node(idx);
-        if (node < 0)
-          continue;
-        Real       grad[dim];
-        const Real N = stencil_weight<dim, n>(w, dw, inv_h, k, grad);
-        visit(node, N, static_cast<const Real *>(grad), static_cast<const Real *>(offset));
-      }
+    visit_stencil_with_offset<dim, n>(grid, first, w, dw, inv_h, x, visit);
   }
 } // namespace mpm
 
