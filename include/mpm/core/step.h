@@ -463,16 +463,18 @@ namespace mpm
               }
             scatter(force, targets + dim + 1);
           }
-#if !defined(__CUDA_ARCH__) && !defined(MPM_UNROLL_STENCIL)
         // Atomic backends: add_affine_momentum, after this pass.
         if constexpr (!atomic_scatter<Backend>::value)
           if (mass_and_momentum && s.affine_state_variable >= 0)
             {
               Real C[dim * dim];
               load_affine(p, s, i, C);
+#if defined(__CUDA_ARCH__) || defined(MPM_UNROLL_STENCIL)
+              add_apic_momentum<Backend, dim>(g, PointStencil<dim, Shape, Real>{x, lp}, x, m, C);
+#else
               add_apic_momentum<Backend, dim>(g, stencil, x, m, C);
-            }
 #endif
+            }
       });
     }
 
@@ -1011,7 +1013,10 @@ namespace mpm
 
   // One step of the chosen scheme. Returns the reductions needed for the next time
   // step and for the time history.
-  // physics: which physics the device's kernels hold (DevicePhysics); the host's hold all.
+  // physics: which physics the device's kernels hold (DevicePhysics); the host's hold all. On the
+  // device a material with Hencky's law needs DevicePhysics::all: the standard kernels run the
+  // Jaumann rate form for it, and the material table lives on the device, so this cannot check it
+  // (DeviceEngine picks the variant from the host's table).
   template <int dim, typename Shape, DevicePhysics physics = DevicePhysics::standard, typename Real, typename Backend,
             typename Exchange = NoGridExchange>
   StepReduction<Real> explicit_step(Backend &backend, const GridView<dim, Real> &g,
