@@ -19,7 +19,7 @@
 //   --material elastic|dp   linear elastic stand-in, or ep2-3De's Drucker-Prager (default dp)
 //   --sort-every N          sort the points by stencil on the device every N steps (0: never;
 //                           default 20), so that the warp adders reduce runs of shared nodes
-//   --shape gimp|linear|bspline2|bspline3   the shape function (default gimp)
+//   --shape gimp|linear|bspline2|bspline3|cpdi   the shape function (default gimp)
 //   --domain detF|Fii|U|none                GIMP's domain update (default detF, P1's own)
 #include "p1_scene.h"
 
@@ -217,7 +217,7 @@ namespace
     auto sort_if_due = [&](const long step) {
       if (opt.sort_every > 0 && step % opt.sort_every == 0)
         {
-          if (opt.shape == ShapeFunction::linear)
+          if (opt.shape == ShapeFunction::linear || opt.shape == ShapeFunction::cpdi) // CPDI: by the point's cell
             order.template sort<LinearShape>(backend, gv, dpoints);
           else if (opt.shape == ShapeFunction::bspline3)
             order.template sort<CubicBSplineShape>(backend, gv, dpoints);
@@ -311,7 +311,8 @@ namespace
     label += opt.drucker_prager ? ", DP" : ", elastic";
     label += opt.shape == ShapeFunction::linear   ? ", linear" :
              opt.shape == ShapeFunction::bspline2 ? ", B-spline" :
-             opt.shape == ShapeFunction::bspline3 ? ", cubic B-spline" : "";
+             opt.shape == ShapeFunction::bspline3 ? ", cubic B-spline" :
+             opt.shape == ShapeFunction::cpdi     ? ", CPDI" : "";
     if (opt.shape == ShapeFunction::gimp)
       label += opt.domain == DomainUpdate::U ? ", U domains" : opt.domain == DomainUpdate::stretch ? ", F_ii domains" :
                opt.domain == DomainUpdate::none ? ", uGIMP" : ", det F domains";
@@ -405,14 +406,15 @@ int main(int argc, char **argv)
       else if (a == "--shape" && i + 1 < argc)
         {
           const std::string m = argv[++i];
-          if (m != "gimp" && m != "linear" && m != "bspline2" && m != "bspline3")
+          if (m != "gimp" && m != "linear" && m != "bspline2" && m != "bspline3" && m != "cpdi")
             {
-              std::printf("--shape: expected gimp, linear, bspline2 or bspline3, got %s\n", m.c_str());
+              std::printf("--shape: expected gimp, linear, bspline2, bspline3 or cpdi, got %s\n", m.c_str());
               return 2;
             }
           opt.shape = m == "gimp"     ? ShapeFunction::gimp :
                       m == "linear"   ? ShapeFunction::linear :
-                      m == "bspline2" ? ShapeFunction::bspline2 : ShapeFunction::bspline3;
+                      m == "bspline2" ? ShapeFunction::bspline2 :
+                      m == "cpdi"     ? ShapeFunction::cpdi : ShapeFunction::bspline3;
         }
       else if (a == "--domain" && i + 1 < argc)
         {
@@ -466,13 +468,14 @@ int main(int argc, char **argv)
         {
           std::printf("usage: %s [--fp32] [--sizes 20,160,640,2560] [--steps N] [--profile] [--table FILE]\n"
                       "          [--order generated|cell|random] [--block N] [--material dp|elastic] [--sort-every N]\n"
-                      "          [--shape gimp|linear|bspline2|bspline3] [--domain detF|Fii|U|none]\n"
+                      "          [--shape gimp|linear|bspline2|bspline3|cpdi] [--domain detF|Fii|U|none]\n"
                       "          [--transfer tpic|apic] [--law jaumann|hencky]\n",
                       argv[0]);
           return 2;
         }
     }
-  if (opt.affine && opt.affine_matrix == AffineMatrix::b_d_inverse && opt.shape == ShapeFunction::gimp)
+  if (opt.affine && opt.affine_matrix == AffineMatrix::b_d_inverse &&
+      (opt.shape == ShapeFunction::gimp || opt.shape == ShapeFunction::cpdi))
     {
       std::printf("--transfer apic: needs --shape linear, bspline2 or bspline3 (GIMP has no constant D_p; use "
                   "--transfer tpic)\n");

@@ -4,7 +4,8 @@
 # Jaumann) timed against an older tree's build, interleaved. Everything goes to $OUT.
 #   scripts/gpu_shape_rows.sh [OLD_TREE]      OLD_TREE: a checkout of the earlier commit
 #   ROWS=0: only the default against the old tree; ROWS=physics: TPIC, APIC and Hencky beside
-#   their standard rows. TESTS=0: no tests; TESTS="a b": those tests
+#   their standard rows; ROWS=cpdi: CPDI (blend, TPIC) beside cpGIMP U. TESTS=0: no tests;
+#   TESTS="a b": those tests
 set -u -o pipefail
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
 OUT=${OUT:-$ROOT/output-gpu}
@@ -45,6 +46,11 @@ row() { echo "== $* ($(date +%T))"; timeout 150 "$@" $P 2>&1 | grep -E "^\| " | 
     row /tmp/new/benchmarks/p1_benchmark --shape bspline2 --transfer apic
     row /tmp/new/benchmarks/p1_benchmark --law hencky
     row /tmp/new/benchmarks/p1_benchmark --domain U --law hencky
+  fi
+  if [ "${ROWS:-1}" = cpdi ]; then
+    row /tmp/new/benchmarks/p1_benchmark --domain U
+    row /tmp/new/benchmarks/p1_benchmark --shape cpdi
+    row /tmp/new/benchmarks/p1_benchmark --shape cpdi --transfer tpic
   fi
   if [ "${ROWS:-1}" = 1 ]; then
     row /tmp/new/benchmarks/p1_benchmark --shape linear

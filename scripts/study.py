@@ -8,7 +8,11 @@ log-log, one marker per method, the front of runs no other run beats in both) an
 convergence plot. doc/methods.md ("The study") gives the results.
 
   study.py --exe build/dealii-mpm --out DIR [--scenes v1,v2,v3,mms] [--methods a,b] [--reduced]
-           [--csv FILE] [--figures DIR] [--check] [--mms-exe build/tests/core/mms_study] [--backend cpu|cuda]
+           [--csv FILE [--merge]] [--figures DIR] [--check] [--mms-exe build/tests/core/mms_study]
+           [--backend cpu|cuda]
+
+--merge: keep the rows already in --csv except those this run measures again (same scene, method, h and
+backend), and draw the charts from all of them (a method added to an existing study).
 
 --backend cuda: the runs through dealii-mpm with Backend = cuda (a build with CUDA, on a GPU machine; TPIC,
 APIC and Hencky run on the CPU only and are refused there; the MMS runs in the core on the CPU whatever this says).
@@ -68,6 +72,7 @@ METHODS = {
     "bspline2_apic": ("B-spline 2, APIC", shape("quadratic B-spline") + ["set Velocity transfer = APIC"], []),
     "cpgimp_u_hencky": ("cpGIMP U, FLIP 0.99, Hencky", shape("GIMP", "U") + ["set FLIP fraction = 0.99"],
                         ["@material", "  set Elastic law = Hencky", "end"]),
+    "cpdi": ("CPDI, FLIP 0.99", shape("CPDI") + ["set FLIP fraction = 0.99"], []),
 }
 
 
@@ -248,6 +253,7 @@ def main():
     ap.add_argument("--methods", default=",".join(METHODS))
     ap.add_argument("--reduced", action="store_true")
     ap.add_argument("--csv")
+    ap.add_argument("--merge", action="store_true", help="keep --csv's other rows (see above)")
     ap.add_argument("--figures")
     ap.add_argument("--check", action="store_true")
     ap.add_argument("--backend", choices=["cpu", "cuda"], default="cpu")
@@ -266,13 +272,20 @@ def main():
                 rows.append(row)
                 print(f"{scene} {METHODS[method][0]:32s} h={h:<8.4g} error={row['error']!s:22.22s} "
                       f"wall={row['wall_s']:.2f}s stable={row['stable']} {row['details']}", flush=True)
+    all_rows = rows
+    if args.merge and args.csv and os.path.exists(args.csv):
+        def key(r):
+            return (r["scene"], r["method"], float(r["h"]), r.get("backend", "cpu"))
+        measured = {key(r) for r in rows}
+        kept = [r for r in csv.DictReader(open(args.csv)) if key(r) not in measured]
+        all_rows = kept + rows
     if args.csv:
         with open(args.csv, "w", newline="") as f:
             w = csv.DictWriter(f, fieldnames=COLUMNS)
             w.writeheader()
-            w.writerows(rows)
+            w.writerows(all_rows)
     if args.figures:
-        draw(rows, args.figures)
+        draw(all_rows, args.figures)
     if args.check:
         failed = [r for r in rows if r["stable"] != "yes" or not float(r["error"]) <= SCENES[r["scene"]][6]]
         for r in failed:

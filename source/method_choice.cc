@@ -29,7 +29,7 @@ namespace mpm
     const std::vector<MethodSettings> &methods()
     {
       const auto g = ShapeFunction::gimp, b2 = ShapeFunction::bspline2, b3 = ShapeFunction::bspline3,
-                 lin = ShapeFunction::linear;
+                 lin = ShapeFunction::linear, cpdi = ShapeFunction::cpdi;
       const auto none = DomainUpdate::none, det_f = DomainUpdate::det_F, f_ii = DomainUpdate::stretch,
                  u = DomainUpdate::U;
       const auto tpic = AffineMatrix::velocity_gradient, apic = AffineMatrix::b_d_inverse;
@@ -48,6 +48,7 @@ namespace mpm
         {"bspline2_tpic", "quadratic B-spline, TPIC", b2, none, true, tpic, 0, false},
         {"bspline2_apic", "quadratic B-spline, APIC", b2, none, true, apic, 0, false},
         {"cpgimp_u_hencky", "cpGIMP U, FLIP 0.99, Hencky", g, u, false, tpic, 0.99, true},
+        {"cpdi", "CPDI, FLIP 0.99", cpdi, none, false, tpic, 0.99, false},
       };
       return all;
     }
@@ -130,7 +131,7 @@ namespace mpm
   }
 
   MethodChoice choose_method(const std::string &scene, const double cells, const double tolerance, const bool cuda,
-                             const bool hencky_allowed, const unsigned int dim)
+                             const bool hencky_allowed, const unsigned int dim, const bool cpdi_allowed)
   {
     if (!(cells > 0) || !(tolerance > 0))
       throw std::invalid_argument("choose_method: cells and tolerance must be > 0");
@@ -157,6 +158,11 @@ namespace mpm
         if (m.hencky && !hencky_allowed)
           {
             left_out << "\n    " << m.label << ": Hencky needs built-in models only";
+            continue;
+          }
+        if (m.shape == ShapeFunction::cpdi && !cpdi_allowed)
+          {
+            left_out << "\n    " << m.label << ": runs on one MPI rank with Grid/Nodes = all";
             continue;
           }
         if (dim == 3 && !m.affine && m.flip_fraction == 1)

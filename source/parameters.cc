@@ -4,6 +4,7 @@
 #include <mpm/dealii/parameters.h>
 
 #include <deal.II/base/exceptions.h>
+#include <deal.II/base/mpi.h>
 #include <deal.II/base/utilities.h>
 
 #include <algorithm>
@@ -149,12 +150,14 @@ namespace mpm
     prm.declare_entry("Update scheme", "MUSL", Patterns::Selection("MUSL|USL|USF"),
                       "Explicit update scheme: MUSL (modified update stress last, default), USL or USF.");
     prm.declare_entry("Shape function", "GIMP",
-                      Patterns::Selection("linear|GIMP|quadratic B-spline|cubic B-spline"),
+                      Patterns::Selection("linear|GIMP|quadratic B-spline|cubic B-spline|CPDI"),
                       "Grid shape functions: linear (standard MPM), GIMP (generalised interpolation), "
                       "quadratic B-spline (C1, three nodes per direction; within half a cell of the grid's "
-                      "faces it becomes linear, doc/theory.md) or cubic B-spline (C2, four nodes per direction, "
+                      "faces it becomes linear, doc/theory.md), cubic B-spline (C2, four nodes per direction, "
                       "the same treatment at the faces; in MPI runs the points are re-sorted whenever one "
-                      "leaves its cell).");
+                      "leaves its cell) or CPDI (the linear hats averaged over each point's parallelogram or "
+                      "parallelepiped domain, whose edges follow F, including its rotation and shear; one MPI "
+                      "rank, Grid/Nodes = all).");
     prm.declare_entry("GIMP domain update", "none", Patterns::Selection("none|det F|F_ii|U"),
                       "How GIMP particle domains follow the deformation: none (uGIMP), det F (cpGIMP, "
                       "half-lengths scaled by det(F)^(1/dim)), F_ii (cpGIMP, half-length i scaled by F_ii; exact "
@@ -492,7 +495,8 @@ namespace mpm
     const std::string shape = prm.get("Shape function");
     shape_function = shape == "GIMP"               ? ShapeFunction::gimp :
                      shape == "quadratic B-spline" ? ShapeFunction::bspline2 :
-                     shape == "cubic B-spline"     ? ShapeFunction::bspline3 : ShapeFunction::linear;
+                     shape == "cubic B-spline"     ? ShapeFunction::bspline3 :
+                     shape == "CPDI"               ? ShapeFunction::cpdi : ShapeFunction::linear;
     const std::string du = prm.get("GIMP domain update");
     domain_update = du == "det F" ? DomainUpdate::det_F :
                     du == "F_ii"  ? DomainUpdate::stretch :
@@ -500,6 +504,10 @@ namespace mpm
     if (shape_function != ShapeFunction::gimp && domain_update != DomainUpdate::none)
       fail("Solver/GIMP domain update", "'" + du + "' needs Shape function = GIMP; with Shape function = " + shape +
                                         " the only allowed value is none.");
+    if (shape_function == ShapeFunction::cpdi && active_block_cells > 0)
+      fail("Grid/Nodes", "'near material' keeps the nodes within a fixed number of cells of each point's cell, "
+                         "but a CPDI domain stretched by the flow reaches farther; with Shape function = CPDI "
+                         "the only allowed value is all.");
     adaptive_time_step = prm.get("Time step") == "adaptive";
     cfl                = prm.get_double("CFL number");
     if (!(cfl > 0))
@@ -517,11 +525,11 @@ namespace mpm
     const std::string transfer = prm.get("Velocity transfer");
     apic                       = transfer == "APIC" || transfer == "TPIC";
     affine_matrix = transfer == "APIC" ? AffineMatrix::b_d_inverse : AffineMatrix::velocity_gradient;
-    if (transfer == "APIC" && shape_function == ShapeFunction::gimp)
+    if (transfer == "APIC" && (shape_function == ShapeFunction::gimp || shape_function == ShapeFunction::cpdi))
       fail("Solver/Velocity transfer", "APIC needs Shape function = linear, quadratic B-spline or cubic B-spline "
-                                       "(its D_p is constant only for the B-splines; with GIMP a D_p computed per "
-                                       "point turns singular at the grid's faces); with Shape function = GIMP use "
-                                       "Velocity transfer = TPIC.");
+                                       "(its D_p is constant only for the B-splines; with GIMP or CPDI a D_p "
+                                       "computed per point turns singular at the grid's faces); with Shape "
+                                       "function = " + shape + " use Velocity transfer = TPIC.");
     if (apic)
       flip_fraction = 0; // APIC's velocity is PIC's plus the affine part
     const bool        method_auto      = prm.get("Method") == "auto";
@@ -831,8 +839,11 @@ namespace mpm
         MethodChoice choice;
         try
           {
+            // CPDI's domains reach beyond a rank's ghost cells and the kept nodes (Solver/Shape function)
+            const bool one_rank = !dealii::Utilities::MPI::job_supports_mpi() ||
+                                  dealii::Utilities::MPI::n_mpi_processes(MPI_COMM_WORLD) == 1;
             choice = choose_method(method_scene, extent / cell_size, method_tolerance, backend == "cuda",
-                                   hencky_allowed, dim);
+                                   hencky_allowed, dim, one_rank && active_block_cells == 0);
           }
         catch (const std::invalid_argument &e)
           {

@@ -7,6 +7,15 @@ namespace mpm
     : state(std::make_unique<State>(parameters, communicator))
   {
     check_memory(parameters, communicator); // before anything large is allocated
+    // A rank holds the nodes of its cells and one ring of ghost cells; a CPDI domain
+    // stretched by the flow reaches beyond that ring, where its weights would be lost.
+    AssertThrow(parameters.shape_function != ShapeFunction::cpdi ||
+                  dealii::Utilities::MPI::n_mpi_processes(communicator) == 1,
+                dealii::ExcMessage("Parameter 'Solver/Shape function': CPDI runs on one MPI rank (its domains "
+                                   "reach beyond the ghost cells of a rank's part of the grid); run this scene "
+                                   "on one rank, or with linear, GIMP, quadratic B-spline or cubic B-spline on " +
+                                   std::to_string(dealii::Utilities::MPI::n_mpi_processes(communicator)) +
+                                   " ranks."));
   }
 
   template <int dim>

@@ -112,7 +112,8 @@ namespace mpm_test
     linear,
     gimp,
     quadratic_bspline,
-    cubic_bspline
+    cubic_bspline,
+    cpdi
   };
   struct MmsMethod
   {
@@ -143,7 +144,8 @@ namespace mpm_test
             {"bspline2_tpic", MmsShape::quadratic_bspline, DomainUpdate::none, 0, true},
             {"bspline2_apic", MmsShape::quadratic_bspline, DomainUpdate::none, 0, true, mpm::ElasticLaw::jaumann_rate,
              mpm::AffineMatrix::b_d_inverse},
-            {"cpgimp_u_hencky", MmsShape::gimp, DomainUpdate::U, 0.99, false, mpm::ElasticLaw::hencky}};
+            {"cpgimp_u_hencky", MmsShape::gimp, DomainUpdate::U, 0.99, false, mpm::ElasticLaw::hencky},
+            {"cpdi", MmsShape::cpdi}};
   }
 
   inline MmsMethod mms_method(const std::string &key)
@@ -304,6 +306,8 @@ namespace mpm_test
           return run_manufactured_solution<mpm::QuadraticBSplineShape>(motion, method, n_cells, cfl, periods);
         case MmsShape::cubic_bspline:
           return run_manufactured_solution<mpm::CubicBSplineShape>(motion, method, n_cells, cfl, periods);
+        case MmsShape::cpdi:
+          return run_manufactured_solution<mpm::CpdiShape>(motion, method, n_cells, cfl, periods);
       }
     throw std::logic_error("run_manufactured_solution: unknown shape");
   }

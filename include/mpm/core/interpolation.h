@@ -15,6 +15,7 @@
 // it slower (doc/performance.md), so it is not the default.
 #pragma once
 
+#include <mpm/core/cpdi.h>
 #include <mpm/core/shape_functions.h>
 #include <mpm/core/views.h>
 
@@ -182,6 +183,34 @@ namespace mpm
       visit_stencil_with_offset<dim, n>(grid, first, w, dw, inv_h, x, visit);
     }
   };
+
+  // CPDI: the point's position and domain, its corners' weights evaluated on each visit.
+  template <int dim, typename Real>
+  struct HostStencil<dim, CpdiShape, Real>
+  {
+    Real x[dim], R[dim * dim];
+
+    HostStencil() = default;
+    HostStencil(const GridView<dim, Real> &, const Real x_p[dim], const Real domain[dim * dim])
+    {
+      for (int d = 0; d < dim; ++d)
+        x[d] = x_p[d];
+      for (int k = 0; k < dim * dim; ++k)
+        R[k] = domain[k];
+    }
+
+    template <typename Visitor>
+    void for_each(const GridView<dim, Real> &grid, Visitor &&visit) const
+    {
+      visit_cpdi_stencil<dim>(grid, x, R,
+                              [&](const int node, const Real N, const Real *grad, const Real *) { visit(node, N, grad); });
+    }
+    template <typename Visitor>
+    void for_each_with_offset(const GridView<dim, Real> &grid, const Real *, Visitor &&visit) const
+    {
+      visit_cpdi_stencil<dim>(grid, x, R, visit);
+    }
+  };
 #endif
 
   template <int dim, typename Shape, typename Real, typename Visitor>
@@ -190,6 +219,16 @@ namespace mpm
                                                     const Real half_length[dim],
                                                     Visitor  &&visit)
   {
+    if constexpr (!Shape::tensor_product) // CPDI: half_length is the domain's R (cpdi.h)
+      {
+        visit_cpdi_stencil<dim>(grid, x, half_length,
+                                [&](const int node, const Real N, const Real *grad, const Real *) {
+                                  visit(node, N, grad);
+                                });
+        return;
+      }
+    else
+      {
 #if !defined(MPM_UNROLL_STENCIL) && !defined(__CUDA_ARCH__)
     HostStencil<dim, Shape, Real>(grid, x, half_length).for_each(grid, visit);
 #else
@@ -275,6 +314,7 @@ namespace mpm
       }
 #  endif
 #endif
+      }
   }
 
   // The same nodes, weights and gradients as for_each_stencil_node, each with the node's offset
@@ -284,14 +324,19 @@ namespace mpm
   MPM_HOST_DEVICE inline void for_each_stencil_node_with_offset(const GridView<dim, Real> &grid, const Real x[dim],
                                                                 const Real half_length[dim], Visitor &&visit)
   {
-    constexpr int n = Shape::n_per_direction;
-    int           first[dim];
-    Real          w[dim][n], dw[dim][n];
-    const Real    inv_h = Real(1) / grid.h;
-    for (int d = 0; d < dim; ++d)
-      stencil_weights_1d<Shape>((x[d] - grid.origin[d]) * inv_h, half_length[d] * inv_h, grid.n_cells[d], first[d], w[d],
-                                dw[d]);
-    visit_stencil_with_offset<dim, n>(grid, first, w, dw, inv_h, x, visit);
+    if constexpr (!Shape::tensor_product)
+      visit_cpdi_stencil<dim>(grid, x, half_length, visit);
+    else
+      {
+        constexpr int n = Shape::n_per_direction;
+        int           first[dim];
+        Real          w[dim][n], dw[dim][n];
+        const Real    inv_h = Real(1) / grid.h;
+        for (int d = 0; d < dim; ++d)
+          stencil_weights_1d<Shape>((x[d] - grid.origin[d]) * inv_h, half_length[d] * inv_h, grid.n_cells[d], first[d], w[d],
+                                    dw[d]);
+        visit_stencil_with_offset<dim, n>(grid, first, w, dw, inv_h, x, visit);
+      }
   }
 } // namespace mpm
 

@@ -1,7 +1,8 @@
 // Shape functions of the background grid, evaluated per point as 1D factors.
 //
 // Each family gives, along one direction, the first lattice node of the point's
-// stencil and the weights and derivatives of the n_per_direction nodes from there.
+// stencil and the weights and derivatives of the n_per_direction nodes from there
+// (tensor_product; CPDI, which is not, lives in cpdi.h).
 // Coordinates are in cell units (s = (x - origin) / h), so derivatives must be
 // multiplied by 1/h by the caller. Tensor products build the dim-D stencil.
 #pragma once
@@ -17,12 +18,14 @@ namespace mpm
     linear = 0, // standard MPM: hat functions on the cell containing the point
     gimp   = 1, // generalised interpolation MP, particle domain of half-length lp
     bspline2 = 2, // quadratic B-spline, its ghost node at a lattice face folded into the face's nodes
-    bspline3 = 3  // cubic B-spline, the same fold
+    bspline3 = 3, // cubic B-spline, the same fold
+    cpdi     = 4  // CPDI: linear hats averaged over a parallelogram / parallelepiped domain following F (cpdi.h)
   };
 
   // Standard MPM: the two nodes of the cell containing s.
   struct LinearShape
   {
+    static constexpr bool tensor_product  = true;
     static constexpr int  n_per_direction = 2;
     static constexpr bool folds_boundary  = false;
 
@@ -74,6 +77,7 @@ namespace mpm
   // GIMP: the nearest node and its two neighbours cover the support h + lp <= 3h/2.
   struct GimpShape
   {
+    static constexpr bool tensor_product  = true;
     static constexpr int  n_per_direction = 3;
     static constexpr bool folds_boundary  = false; // weights beyond the lattice are zero for points inside
 
@@ -92,6 +96,7 @@ namespace mpm
   // lattice; fold_boundary (below) removes it.
   struct QuadraticBSplineShape
   {
+    static constexpr bool tensor_product  = true;
     static constexpr int  n_per_direction = 3;
     static constexpr bool folds_boundary  = true;
 
@@ -130,6 +135,7 @@ namespace mpm
   // outside the lattice; fold_boundary (below) removes it.
   struct CubicBSplineShape
   {
+    static constexpr bool tensor_product  = true;
     static constexpr int  n_per_direction = 4;
     static constexpr bool folds_boundary  = true;
 

@@ -160,6 +160,21 @@ namespace mpm
     : std::true_type
   {};
 
+  // A point's domain as the stencil reads it (domain_values<dim, Shape>() values): the
+  // current half-lengths for the tensor-product shapes; CPDI's R = F R_0 (cpdi.h), R_0 the
+  // initial half-lengths on the diagonal, from the point's F of the step's start.
+  template <int dim, typename Shape, typename Real>
+  MPM_HOST_DEVICE inline void load_domain(const PointsView<dim, Real> &p, const int i, Real *domain)
+  {
+    if constexpr (Shape::tensor_product)
+      for (int d = 0; d < dim; ++d)
+        domain[d] = p.domain_half_length[d][i];
+    else
+      for (int a = 0; a < dim; ++a)
+        for (int b = 0; b < dim; ++b)
+          domain[a * dim + b] = p.deformation_gradient[a * dim + b][i] * p.initial_domain_half_length[b][i];
+  }
+
   namespace stages
   {
     // For colouring backends: group the points by the first lattice layer of their
@@ -183,6 +198,41 @@ namespace mpm
           // puts that one lower. GIMP: the cell always lies in [first, first + 2] (s is at
           // least half a cell above the first node), so the key is first and the span 3.
           // Linear: the cell can be first - 1 at a face, so the span is 3, not 2.
+          if constexpr (!Shape::tensor_product)
+            {
+              // CPDI: from the lowest layer its corners' cells write (or its own cell) to the
+              // highest; the span is the widest of all points now (a domain stretched over
+              // several cells writes several layers).
+              auto layers = [&](const int i, int &lo, int &hi) {
+                Real x[dim], R[dim * dim];
+                for (int d = 0; d < dim; ++d)
+                  x[d] = p.position[d][i];
+                load_domain<dim, Shape>(p, i, R);
+                cpdi_layers<dim>(g.origin[axis], g.h, g.n_cells[axis], x[axis], R, axis, lo, hi);
+                int cell = static_cast<int>(std::floor((x[axis] - g.origin[axis]) / g.h));
+                cell     = cell < 0 ? 0 : (cell >= g.n_cells[axis] ? g.n_cells[axis] - 1 : cell);
+                lo       = cell < lo ? cell : lo;
+                hi       = cell + 1 > hi ? cell + 1 : hi;
+              };
+              int span = 3;
+              for (int i = 0; i < p.n_points; ++i)
+                if (p.material[i] >= 0)
+                  {
+                    int lo, hi;
+                    layers(i, lo, hi);
+                    span = hi - lo + 1 > span ? hi - lo + 1 : span;
+                  }
+              backend.group_points(p.n_points, g.n_cells[axis] + 1, span, [&](const int i) {
+                if (p.material[i] < 0)
+                  return -1;
+                int lo, hi;
+                layers(i, lo, hi);
+                return lo;
+              });
+              return;
+            }
+          else
+            {
           constexpr int n    = Shape::n_per_direction;
           constexpr int span = n == 2 ? 3 : n;
           const Real    inv_h = Real(1) / g.h;
@@ -198,6 +248,7 @@ namespace mpm
             const int key = first < cell ? first : cell;
             return key < 0 ? 0 : key;
           });
+            }
         }
     }
 
@@ -384,13 +435,13 @@ namespace mpm
       backend.scatter_points(p.n_points, [=] MPM_HOST_DEVICE(const int i) {
         if (p.material[i] < 0)
           return;
-        Real x[dim], lp[dim], v[dim];
+        Real x[dim], lp[domain_values<dim, Shape>()], v[dim];
         for (int d = 0; d < dim; ++d)
           {
             x[d]  = p.position[d][i];
-            lp[d] = p.domain_half_length[d][i];
             v[d]  = p.velocity[d][i];
           }
+        load_domain<dim, Shape>(p, i, lp);
         const Real m = p.mass[i], V = p.volume[i];
         SymTensor<Real> sigma;
         for (int c = 0; c < n_voigt; ++c)
@@ -488,12 +539,10 @@ namespace mpm
       backend.scatter_points(p.n_points, [=] MPM_HOST_DEVICE(const int i) {
         if (p.material[i] < 0)
           return;
-        Real x[dim], lp[dim], C[dim * dim];
+        Real x[dim], lp[domain_values<dim, Shape>()], C[dim * dim];
         for (int d = 0; d < dim; ++d)
-          {
-            x[d]  = p.position[d][i];
-            lp[d] = p.domain_half_length[d][i];
-          }
+          x[d] = p.position[d][i];
+        load_domain<dim, Shape>(p, i, lp);
         load_affine(p, s, i, C);
         add_apic_momentum<Backend, dim>(g, PointStencil<dim, Shape, Real>{x, lp}, x, p.mass[i], C);
       });
@@ -620,12 +669,10 @@ namespace mpm
       backend.gather_points(p.n_points, [=] MPM_HOST_DEVICE(const int i) {
         if (p.material[i] < 0)
           return;
-        Real x[dim], lp[dim], v_new[dim];
+        Real x[dim], lp[domain_values<dim, Shape>()], v_new[dim];
         for (int d = 0; d < dim; ++d)
-          {
-            x[d]  = p.position[d][i];
-            lp[d] = p.domain_half_length[d][i];
-          }
+          x[d] = p.position[d][i];
+        load_domain<dim, Shape>(p, i, lp);
         updated_point_velocity<dim>(
           g, p, s, i, [&](auto &&visit) { for_each_stencil_node<dim, Shape>(g, x, lp, visit); }, v_new);
         for (int d = 0; d < dim; ++d)
@@ -659,12 +706,10 @@ namespace mpm
       backend.scatter_points(p.n_points, [=] MPM_HOST_DEVICE(const int i) {
         if (p.material[i] < 0)
           return;
-        Real x[dim], lp[dim], v_new[dim], mv[dim];
+        Real x[dim], lp[domain_values<dim, Shape>()], v_new[dim], mv[dim];
         for (int d = 0; d < dim; ++d)
-          {
-            x[d]  = p.position[d][i];
-            lp[d] = p.domain_half_length[d][i];
-          }
+          x[d] = p.position[d][i];
+        load_domain<dim, Shape>(p, i, lp);
         (void)stencils; // captured in both compilation passes (nvcc's extended lambdas need the same captures)
 #if defined(__CUDA_ARCH__) || defined(MPM_UNROLL_STENCIL)
         auto stencil = [&](auto &&visit) { for_each_stencil_node<dim, Shape>(g, x, lp, visit); };
@@ -771,13 +816,11 @@ namespace mpm
       backend.gather_points(p.n_points, [=] MPM_HOST_DEVICE(const int i) {
         if (p.material[i] < 0)
           return;
-        Real x[dim], lp[dim], dx[dim] = {};
+        Real x[dim], lp[domain_values<dim, Shape>()], dx[dim] = {};
         Mat3<Real> L = Mat3<Real>::zero(); // velocity gradient; plane strain keeps row/column z zero
         for (int d = 0; d < dim; ++d)
-          {
-            x[d]  = p.position[d][i];
-            lp[d] = p.domain_half_length[d][i];
-          }
+          x[d] = p.position[d][i];
+        load_domain<dim, Shape>(p, i, lp);
         auto visit = [&](const int n, const Real N, const Real *grad) {
           for (int d = 0; d < dim; ++d)
             {
@@ -1173,6 +1216,8 @@ namespace mpm
       return explicit_step<dim, QuadraticBSplineShape, physics>(backend, g, p, materials, s, dt, exchange, averaging_pending);
     if (shape == ShapeFunction::bspline3)
       return explicit_step<dim, CubicBSplineShape, physics>(backend, g, p, materials, s, dt, exchange, averaging_pending);
+    if (shape == ShapeFunction::cpdi)
+      return explicit_step<dim, CpdiShape, physics>(backend, g, p, materials, s, dt, exchange, averaging_pending);
     return explicit_step<dim, LinearShape, physics>(backend, g, p, materials, s, dt, exchange, averaging_pending);
   }
 } // namespace mpm

@@ -265,9 +265,30 @@ namespace mpm
     // is not wholly inside the lattice are runs of one. A warp that is not fully
     // converged (a removed point, the last partial warp) or a block larger than the
     // staging area adds point by point.
+    // CPDI (not a tensor product: corner by corner, cpdi.h) adds point by point.
     template <int dim, typename Shape, int K, int Kg, typename Real>
     MPM_HOST_DEVICE static void scatter_stencil(const GridView<dim, Real> &g, const Real x[dim], const Real lp[dim],
                                                 Real *const *targets, const StencilContribution<dim, K, Kg, Real> &c)
+    {
+      if constexpr (Shape::tensor_product)
+        scatter_tensor_stencil<dim, Shape>(g, x, lp, targets, c);
+      else
+        for_each_stencil_node<dim, Shape>(g, x, lp, [&](const int node, const Real N, const Real *grad) {
+          Real values[K];
+          c.values(N, grad, values);
+          for (int v = 0; v < K; ++v)
+#if defined(__CUDA_ARCH__)
+            atomicAdd(&targets[v][node], values[v]);
+#else
+            targets[v][node] += values[v];
+#endif
+        });
+    }
+
+    template <int dim, typename Shape, int K, int Kg, typename Real>
+    MPM_HOST_DEVICE static void scatter_tensor_stencil(const GridView<dim, Real> &g, const Real x[dim],
+                                                       const Real lp[dim], Real *const *targets,
+                                                       const StencilContribution<dim, K, Kg, Real> &c)
     {
 #if defined(__CUDA_ARCH__)
       using Pair                     = typename cuda_detail::Pair<Real>::type;

@@ -21,6 +21,7 @@
 #include <cub/device/device_radix_sort.cuh>
 
 #include <stdexcept>
+#include <type_traits>
 #include <vector>
 
 namespace mpm
@@ -101,10 +102,12 @@ namespace mpm
         long lattice = 0;
         for (int d = dim - 1; d >= 0; --d)
           {
-            constexpr int n_w = Shape::n_per_direction;
+            // CPDI (not a tensor product): by the point's cell, the linear shape's first node
+            using KeyShape    = std::conditional_t<Shape::tensor_product, Shape, LinearShape>;
+            constexpr int n_w = KeyShape::n_per_direction;
             int           first;
             Real          w[n_w], dw[n_w];
-            Shape::weights_1d((p.position[d][i] - g.origin[d]) / g.h, p.domain_half_length[d][i] / g.h, first, w,
+            KeyShape::weights_1d((p.position[d][i] - g.origin[d]) / g.h, p.domain_half_length[d][i] / g.h, first, w,
                               dw);
             first   = first < 0 ? 0 : (first > g.n_cells[d] ? g.n_cells[d] : first);
             lattice = lattice * (g.n_cells[d] + 1) + first;
