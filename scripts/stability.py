@@ -46,6 +46,8 @@ METHODS = {
     # Material entries: "@material" stands for each material of the scene's prm.
     "cpgimp_u_hencky": ("cpGIMP U, Hencky", ["set Shape function = GIMP", "set GIMP domain update = U"],
                         ["@material", "  set Elastic law = Hencky", "end"]),
+    "cpdi": ("CPDI", ["set Shape function = CPDI", "set GIMP domain update = none"]),
+    "cpdi2q": ("CPDI2q", ["set Shape function = CPDI2q", "set GIMP domain update = none"]),
 }
 
 

@@ -73,6 +73,7 @@ METHODS = {
     "cpgimp_u_hencky": ("cpGIMP U, FLIP 0.99, Hencky", shape("GIMP", "U") + ["set FLIP fraction = 0.99"],
                         ["@material", "  set Elastic law = Hencky", "end"]),
     "cpdi": ("CPDI, FLIP 0.99", shape("CPDI") + ["set FLIP fraction = 0.99"], []),
+    "cpdi2q": ("CPDI2q, FLIP 0.99", shape("CPDI2q") + ["set FLIP fraction = 0.99"], []),
 }
 
 

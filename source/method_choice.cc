@@ -29,7 +29,7 @@ namespace mpm
     const std::vector<MethodSettings> &methods()
     {
       const auto g = ShapeFunction::gimp, b2 = ShapeFunction::bspline2, b3 = ShapeFunction::bspline3,
-                 lin = ShapeFunction::linear, cpdi = ShapeFunction::cpdi;
+                 lin = ShapeFunction::linear, cpdi = ShapeFunction::cpdi, cpdi2q = ShapeFunction::cpdi2q;
       const auto none = DomainUpdate::none, det_f = DomainUpdate::det_F, f_ii = DomainUpdate::stretch,
                  u = DomainUpdate::U;
       const auto tpic = AffineMatrix::velocity_gradient, apic = AffineMatrix::b_d_inverse;
@@ -49,6 +49,7 @@ namespace mpm
         {"bspline2_apic", "quadratic B-spline, APIC", b2, none, true, apic, 0, false},
         {"cpgimp_u_hencky", "cpGIMP U, FLIP 0.99, Hencky", g, u, false, tpic, 0.99, true},
         {"cpdi", "CPDI, FLIP 0.99", cpdi, none, false, tpic, 0.99, false},
+        {"cpdi2q", "CPDI2q, FLIP 0.99", cpdi2q, none, false, tpic, 0.99, false},
       };
       return all;
     }
@@ -160,9 +161,14 @@ namespace mpm
             left_out << "\n    " << m.label << ": Hencky needs built-in models only";
             continue;
           }
-        if (m.shape == ShapeFunction::cpdi && !cpdi_allowed)
+        if ((m.shape == ShapeFunction::cpdi || m.shape == ShapeFunction::cpdi2q) && !cpdi_allowed)
           {
             left_out << "\n    " << m.label << ": runs on one MPI rank with Grid/Nodes = all";
+            continue;
+          }
+        if (dim == 3 && m.shape == ShapeFunction::cpdi2q)
+          {
+            left_out << "\n    " << m.label << ": two-dimensional";
             continue;
           }
         if (dim == 3 && !m.affine && m.flip_fraction == 1)

@@ -150,14 +150,15 @@ namespace mpm
     prm.declare_entry("Update scheme", "MUSL", Patterns::Selection("MUSL|USL|USF"),
                       "Explicit update scheme: MUSL (modified update stress last, default), USL or USF.");
     prm.declare_entry("Shape function", "GIMP",
-                      Patterns::Selection("linear|GIMP|quadratic B-spline|cubic B-spline|CPDI"),
+                      Patterns::Selection("linear|GIMP|quadratic B-spline|cubic B-spline|CPDI|CPDI2q"),
                       "Grid shape functions: linear (standard MPM), GIMP (generalised interpolation), "
                       "quadratic B-spline (C1, three nodes per direction; within half a cell of the grid's "
                       "faces it becomes linear, doc/theory.md), cubic B-spline (C2, four nodes per direction, "
                       "the same treatment at the faces; in MPI runs the points are re-sorted whenever one "
-                      "leaves its cell) or CPDI (the linear hats averaged over each point's parallelogram or "
-                      "parallelepiped domain, whose edges follow F, including its rotation and shear; one MPI "
-                      "rank, Grid/Nodes = all).");
+                      "leaves its cell), CPDI (the linear hats averaged over each point's parallelogram or "
+                      "parallelepiped domain, whose edges follow F, including its rotation and shear) or CPDI2q "
+                      "(2D: the same over a quadrilateral whose four corners move with the grid's velocity). "
+                      "CPDI and CPDI2q: one MPI rank, Grid/Nodes = all.");
     prm.declare_entry("GIMP domain update", "none", Patterns::Selection("none|det F|F_ii|U"),
                       "How GIMP particle domains follow the deformation: none (uGIMP), det F (cpGIMP, "
                       "half-lengths scaled by det(F)^(1/dim)), F_ii (cpGIMP, half-length i scaled by F_ii; exact "
@@ -496,7 +497,12 @@ namespace mpm
     shape_function = shape == "GIMP"               ? ShapeFunction::gimp :
                      shape == "quadratic B-spline" ? ShapeFunction::bspline2 :
                      shape == "cubic B-spline"     ? ShapeFunction::bspline3 :
-                     shape == "CPDI"               ? ShapeFunction::cpdi : ShapeFunction::linear;
+                     shape == "CPDI"               ? ShapeFunction::cpdi :
+                     shape == "CPDI2q"             ? ShapeFunction::cpdi2q : ShapeFunction::linear;
+    const bool cpdi_family = shape_function == ShapeFunction::cpdi || shape_function == ShapeFunction::cpdi2q;
+    if (shape_function == ShapeFunction::cpdi2q && dim != 2)
+      fail("Solver/Shape function", "CPDI2q is two-dimensional (its domains are quadrilaterals); in 3D use CPDI, "
+                                    "whose parallelepipeds follow F.");
     const std::string du = prm.get("GIMP domain update");
     domain_update = du == "det F" ? DomainUpdate::det_F :
                     du == "F_ii"  ? DomainUpdate::stretch :
@@ -504,10 +510,10 @@ namespace mpm
     if (shape_function != ShapeFunction::gimp && domain_update != DomainUpdate::none)
       fail("Solver/GIMP domain update", "'" + du + "' needs Shape function = GIMP; with Shape function = " + shape +
                                         " the only allowed value is none.");
-    if (shape_function == ShapeFunction::cpdi && active_block_cells > 0)
+    if (cpdi_family && active_block_cells > 0)
       fail("Grid/Nodes", "'near material' keeps the nodes within a fixed number of cells of each point's cell, "
-                         "but a CPDI domain stretched by the flow reaches farther; with Shape function = CPDI "
-                         "the only allowed value is all.");
+                         "but a CPDI domain stretched by the flow reaches farther; with Shape function = " + shape +
+                         " the only allowed value is all.");
     adaptive_time_step = prm.get("Time step") == "adaptive";
     cfl                = prm.get_double("CFL number");
     if (!(cfl > 0))
@@ -525,7 +531,7 @@ namespace mpm
     const std::string transfer = prm.get("Velocity transfer");
     apic                       = transfer == "APIC" || transfer == "TPIC";
     affine_matrix = transfer == "APIC" ? AffineMatrix::b_d_inverse : AffineMatrix::velocity_gradient;
-    if (transfer == "APIC" && (shape_function == ShapeFunction::gimp || shape_function == ShapeFunction::cpdi))
+    if (transfer == "APIC" && (shape_function == ShapeFunction::gimp || cpdi_family))
       fail("Solver/Velocity transfer", "APIC needs Shape function = linear, quadratic B-spline or cubic B-spline "
                                        "(its D_p is constant only for the B-splines; with GIMP or CPDI a D_p "
                                        "computed per point turns singular at the grid's faces); with Shape "
@@ -893,12 +899,22 @@ namespace mpm
       for (unsigned int a = 0; a < dim; ++a)
         for (unsigned int b = 0; b < dim; ++b)
           names.push_back(std::string("apic_C_") + "xyz"[a] + "xyz"[b]);
+    if (shape_function == ShapeFunction::cpdi2q) // CPDI2q's corners, last (corner_state_variable())
+      for (unsigned int c = 0; c < 4; ++c)
+        for (unsigned int d = 0; d < dim; ++d)
+          names.push_back("cpdi2q_corner" + std::to_string(c + 1) + "_d" + "xyz"[d]);
     return names;
   }
 
   int Parameters::affine_state_variable() const
   {
-    return apic ? static_cast<int>(state_variable_names().size() - dim * dim) : -1;
+    const int corners = shape_function == ShapeFunction::cpdi2q ? 4 * static_cast<int>(dim) : 0;
+    return apic ? static_cast<int>(state_variable_names().size()) - static_cast<int>(dim * dim) - corners : -1;
+  }
+
+  int Parameters::corner_state_variable() const
+  {
+    return shape_function == ShapeFunction::cpdi2q ? static_cast<int>(state_variable_names().size()) - 4 * dim : -1;
   }
 
   std::vector<double> Parameters::initial_state_variables(const unsigned int material) const

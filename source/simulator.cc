@@ -9,11 +9,12 @@ namespace mpm
     check_memory(parameters, communicator); // before anything large is allocated
     // A rank holds the nodes of its cells and one ring of ghost cells; a CPDI domain
     // stretched by the flow reaches beyond that ring, where its weights would be lost.
-    AssertThrow(parameters.shape_function != ShapeFunction::cpdi ||
+    AssertThrow((parameters.shape_function != ShapeFunction::cpdi &&
+                 parameters.shape_function != ShapeFunction::cpdi2q) ||
                   dealii::Utilities::MPI::n_mpi_processes(communicator) == 1,
-                dealii::ExcMessage("Parameter 'Solver/Shape function': CPDI runs on one MPI rank (its domains "
-                                   "reach beyond the ghost cells of a rank's part of the grid); run this scene "
-                                   "on one rank, or with linear, GIMP, quadratic B-spline or cubic B-spline on " +
+                dealii::ExcMessage("Parameter 'Solver/Shape function': CPDI and CPDI2q run on one MPI rank (their "
+                                   "domains reach beyond the ghost cells of a rank's part of the grid); run this "
+                                   "scene on one rank, or with linear, GIMP, quadratic B-spline or cubic B-spline on " +
                                    std::to_string(dealii::Utilities::MPI::n_mpi_processes(communicator)) +
                                    " ranks."));
   }
@@ -188,12 +189,14 @@ namespace mpm
       {
         if (s.parallel)
           *given_bodies = gather_bodies(*given_bodies, s.communicator);
-        // APIC's affine matrices are the program's, not the caller's: points handed over
-        // without them start with C = 0.
-        if (parameters.affine_state_variable() >= 0)
+        // APIC's affine matrices and CPDI2q's corners are the program's, not the caller's: points
+        // handed over without them start with C = 0 and their initial rectangles.
+        const int own = parameters.affine_state_variable() >= 0 ? parameters.affine_state_variable() :
+                                                                    parameters.corner_state_variable();
+        if (own >= 0)
           for (GeneratedBody<dim> &body : *given_bodies)
-            if (body.points.size() > 0 && body.points.n_state_variables() == parameters.affine_state_variable())
-              body.points.set_n_state_variables(parameters.affine_state_variable() + dim * dim);
+            if (body.points.size() > 0 && body.points.n_state_variables() == own)
+              body.points.set_n_state_variables(static_cast<int>(parameters.state_variable_names().size()));
         check_state_variable_count(*given_bodies, parameters);
         *given_bodies = in_canonical_order(*given_bodies);
         check_given_points(*given_bodies, parameters);

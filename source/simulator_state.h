@@ -533,6 +533,7 @@ namespace mpm
       settings.flip_fraction      = parameters.flip_fraction;
       settings.affine_state_variable = parameters.affine_state_variable();
       settings.affine_matrix         = parameters.affine_matrix;
+      settings.corner_state_variable = parameters.corner_state_variable();
       settings.domain_update      = parameters.domain_update;
       settings.pressure_averaging = parameters.pressure_averaging;
       settings.mass_tolerance     = 1e-12 * m_min; // nodes lighter than that carry no velocity

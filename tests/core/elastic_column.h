@@ -60,6 +60,8 @@ namespace mpm_test
     BodyDescription<2, double> body{2, rho, {0, 0}, 0};
     const double               hi[2] = {h, l0};
     add_points(points, grid, lower, hi, body, [](const double *) { return true; });
+    if constexpr (Shape::tracks_corners) // CPDI2q's corners, as offsets from the rectangle: zero
+      points.set_n_state_variables(8);
     if (initial != nullptr)
       points = *initial;
     const std::vector<double> y0 = points.position[1];
@@ -76,6 +78,8 @@ namespace mpm_test
     s.flip_fraction  = setup.flip_fraction;
     s.domain_update  = setup.domain_update;
     s.mass_tolerance = 1e-12 * points.mass[0];
+    if constexpr (Shape::tracks_corners)
+      s.corner_state_variable = 0;
 
     ColumnResult r;
     {

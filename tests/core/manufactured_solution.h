@@ -113,7 +113,8 @@ namespace mpm_test
     gimp,
     quadratic_bspline,
     cubic_bspline,
-    cpdi
+    cpdi,
+    cpdi2q
   };
   struct MmsMethod
   {
@@ -145,7 +146,8 @@ namespace mpm_test
             {"bspline2_apic", MmsShape::quadratic_bspline, DomainUpdate::none, 0, true, mpm::ElasticLaw::jaumann_rate,
              mpm::AffineMatrix::b_d_inverse},
             {"cpgimp_u_hencky", MmsShape::gimp, DomainUpdate::U, 0.99, false, mpm::ElasticLaw::hencky},
-            {"cpdi", MmsShape::cpdi}};
+            {"cpdi", MmsShape::cpdi},
+            {"cpdi2q", MmsShape::cpdi2q}};
   }
 
   inline MmsMethod mms_method(const std::string &key)
@@ -198,9 +200,11 @@ namespace mpm_test
                [](const double *) { return true; });
     const int                 n = points.size();
     const std::vector<double> X[dim] = {points.position[0], points.position[1]};
-    // state variables: the body force (2), then APIC's affine matrix (4)
-    const int body_force = 0, affine = 2;
-    points.set_n_state_variables(method.apic ? 6 : 2);
+    // state variables: the body force (2), then APIC's affine matrix (4), then CPDI2q's corners (8)
+    const int  body_force = 0, affine = 2;
+    const bool corners    = Shape::tracks_corners;
+    const int  corner     = method.apic ? 6 : 2;
+    points.set_n_state_variables(corner + (corners ? 8 : 0));
     for (int i = 0; i < n; ++i)
       for (int d = 0; d < dim; ++d)
         {
@@ -226,6 +230,7 @@ namespace mpm_test
     s.body_force_state_variable = body_force;
     s.affine_state_variable     = method.apic ? affine : -1;
     s.affine_matrix             = method.affine;
+    s.corner_state_variable     = corners ? corner : -1;
 
     double V0 = 0;
     for (int i = 0; i < n; ++i)
@@ -308,6 +313,8 @@ namespace mpm_test
           return run_manufactured_solution<mpm::CubicBSplineShape>(motion, method, n_cells, cfl, periods);
         case MmsShape::cpdi:
           return run_manufactured_solution<mpm::CpdiShape>(motion, method, n_cells, cfl, periods);
+        case MmsShape::cpdi2q:
+          return run_manufactured_solution<mpm::Cpdi2qShape>(motion, method, n_cells, cfl, periods);
       }
     throw std::logic_error("run_manufactured_solution: unknown shape");
   }

@@ -77,6 +77,11 @@ namespace mpm_test
         std::fill(points.state_variables[1].begin(), points.state_variables[1].end(), -omega);
         std::fill(points.state_variables[dim].begin(), points.state_variables[dim].end(), omega);
       }
+    // CPDI2q's corners after the affine matrix: offsets from the rectangle, zero at the start
+    const int corner = transfer.apic ? dim * dim : 0;
+    if constexpr (Shape::tracks_corners)
+      if (points.n_state_variables() < corner + (1 << dim) * dim)
+        points.set_n_state_variables(corner + (1 << dim) * dim);
     const std::vector<double> x0 = points.position[0], y0 = points.position[1];
     auto kinetic = [&]() {
       double k = 0;
@@ -107,6 +112,7 @@ namespace mpm_test
     s.flip_fraction  = transfer.apic ? 0 : transfer.flip_fraction;
     s.affine_state_variable = transfer.apic ? 0 : -1;
     s.affine_matrix         = transfer.affine;
+    s.corner_state_variable = Shape::tracks_corners ? corner : -1;
     s.domain_update  = update;
     s.mass_tolerance = 1e-12 * points.mass[0];
 

@@ -272,11 +272,106 @@ void check_cpdi(std::mt19937 &rng)
   mpm_test::check_below(worst_in_cell, 1e-13, "inside one cell CPDI is the linear hat's exact average");
 }
 
+// CPDI2q (2D): random quadrilaterals (a random parallelogram's corners each moved by up to a
+// fifth of the domain's size): partition of unity, gradients summing to zero, a linear field
+// reproduced as its mean over the quadrilateral (the value at the centroid) and its gradient
+// exactly; on a parallelogram CPDI2q's weights are CPDI's.
+void check_cpdi2q(std::mt19937 &rng)
+{
+  HostGrid<2, double> grid;
+  const double        lower[2] = {-1.0, 0.5};
+  const int           cells[2] = {9, 8};
+  grid.make_dense(lower, 0.37, cells);
+  const GridView<2, double>              g = grid.view();
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  double worst_sum = 0, worst_grad = 0, worst_centroid = 0, worst_linear_grad = 0, worst_parallelogram = 0;
+  for (int trial = 0; trial < 1000; ++trial)
+    {
+      double R[4], x[2], q[8];
+      random_domain<2>(rng, g.h, trial % 3 == 0 ? 2.0 : 0.8, R);
+      for (int d = 0; d < 2; ++d)
+        x[d] = g.origin[d] + (2.5 + u(rng) * (g.n_cells[d] - 5)) * g.h;
+      for (int c = 0; c < 4; ++c)
+        for (int d = 0; d < 2; ++d)
+          q[2 * c + d] = corner_offset<2, CpdiShape>(R, d, c);
+      // a parallelogram first: CPDI's weights
+      {
+        const NodeValues<2> a = stencil_of<2, CpdiShape>(g, x, R), b = stencil_of<2, Cpdi2qShape>(g, x, q);
+        for (const auto &[n, value] : a)
+          {
+            const auto &other = b.at(n);
+            worst_parallelogram = std::max({worst_parallelogram, std::abs(value.first - other.first),
+                                            std::abs(value.second[0] - other.second[0]) * g.h,
+                                            std::abs(value.second[1] - other.second[1]) * g.h});
+          }
+      }
+      const double size = std::sqrt(std::abs(R[0] * R[3] - R[1] * R[2]));
+      for (int k = 0; k < 8; ++k)
+        q[k] += 0.2 * size * (2 * u(rng) - 1);
+      double wf[4], wg[4][2];
+      if (!(cpdi2q_corner_factors(q, wf, wg) > 0))
+        continue;
+      // the centroid by 2 x 2 Gauss points of the isoparametric map
+      double centroid[2] = {}, volume = 0;
+      for (int k = 0; k < 4; ++k)
+        {
+          const double xi = (k & 1 ? 1 : -1) / std::sqrt(3.0), eta = (k & 2 ? 1 : -1) / std::sqrt(3.0);
+          double       pos[2] = {}, J[4] = {};
+          for (int c = 0; c < 4; ++c)
+            {
+              const double sx = c & 1 ? 1 : -1, sy = c & 2 ? 1 : -1;
+              const double phi = 0.25 * (1 + sx * xi) * (1 + sy * eta);
+              for (int d = 0; d < 2; ++d)
+                {
+                  pos[d] += phi * q[2 * c + d];
+                  J[2 * d] += 0.25 * sx * (1 + sy * eta) * q[2 * c + d];
+                  J[2 * d + 1] += 0.25 * sy * (1 + sx * xi) * q[2 * c + d];
+                }
+            }
+          const double det = J[0] * J[3] - J[1] * J[2];
+          volume += det;
+          for (int d = 0; d < 2; ++d)
+            centroid[d] += det * pos[d];
+        }
+      const NodeValues<2> S   = stencil_of<2, Cpdi2qShape>(g, x, q);
+      double              sum = 0, grad_sum[2] = {}, moment[2] = {}, moment_grad[2][2] = {};
+      for (const auto &[n, value] : S)
+        {
+          sum += value.first;
+          for (int d = 0; d < 2; ++d)
+            {
+              const double x_n = node_coordinate(g, n, d);
+              grad_sum[d] += value.second[d];
+              moment[d] += value.first * x_n;
+              for (int e = 0; e < 2; ++e)
+                moment_grad[d][e] += x_n * value.second[e];
+            }
+        }
+      worst_sum = std::max(worst_sum, std::abs(sum - 1));
+      for (int d = 0; d < 2; ++d)
+        {
+          worst_grad     = std::max(worst_grad, std::abs(grad_sum[d]) * g.h);
+          worst_centroid = std::max(worst_centroid, std::abs(moment[d] - (x[d] + centroid[d] / volume)) / g.h);
+          for (int e = 0; e < 2; ++e)
+            worst_linear_grad = std::max(worst_linear_grad, std::abs(moment_grad[d][e] - (d == e ? 1.0 : 0.0)));
+        }
+    }
+  std::printf("CPDI2q: max |sum S - 1| = %.2e, |sum grad S| h = %.2e, linear field against its value at the "
+              "centroid %.2e, linear gradient %.2e, parallelogram against CPDI %.2e\n",
+              worst_sum, worst_grad, worst_centroid, worst_linear_grad, worst_parallelogram);
+  mpm_test::check_below(worst_sum, 1e-14, "CPDI2q: partition of unity");
+  mpm_test::check_below(worst_grad, 1e-12, "CPDI2q: gradients sum to zero");
+  mpm_test::check_below(worst_centroid, 1e-12, "CPDI2q: a linear field's mean over the quadrilateral");
+  mpm_test::check_below(worst_linear_grad, 1e-12, "CPDI2q: gradients of linear fields reproduced");
+  mpm_test::check_below(worst_parallelogram, 1e-13, "CPDI2q on a parallelogram = CPDI");
+}
+
 int main()
 {
   std::mt19937 rng(7);
   check_cpdi<2>(rng);
   check_cpdi<3>(rng);
+  check_cpdi2q(rng);
 
   // An axis-aligned domain inside a cell: uGIMP's weights (both the hat's exact average there).
   HostGrid<2, double> grid;

@@ -109,5 +109,6 @@ int main()
   check_convergence("cpgimp_u", 1.5e-2);
   check_convergence("cpgimp_u_hencky", 1.5e-2);
   check_convergence("cpdi", 1.5e-2);
+  check_convergence("cpdi2q", 1.5e-2);
   return mpm_test::finish("test_manufactured_solution");
 }

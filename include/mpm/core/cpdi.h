@@ -21,18 +21,44 @@ namespace mpm
   struct CpdiShape
   {
     static constexpr bool tensor_product   = false;
-    static constexpr int  n_per_direction  = 2; // linear hats at each corner
+    static constexpr bool tracks_corners   = false; // the domain comes from F (R = F R_0)
+    static constexpr int  n_per_direction  = 2;     // linear hats at each corner
     static constexpr bool folds_boundary   = false;
     template <int dim>
-    static constexpr int corners = 1 << dim;
+    static constexpr int domain_values = dim * dim; // R, row-major
+  };
+
+  // CPDI2q (Sadeghirad, Brannon & Guilkey 2013), 2D: the domain is a general quadrilateral
+  // whose four corners move with the grid's velocity at each corner, x_c += dt sum_i N_i(x_c)
+  // v_i, independently of the point; the linear hats are interpolated bilinearly between the
+  // corners (the isoparametric map of the quadrilateral) and averaged over it:
+  //   S_ip      = sum_c N_i(x_c) (1/V) int Phi_c dV
+  //   grad S_ip = sum_c N_i(x_c) (1/V) int grad Phi_c dV,   V = int dV,
+  // integrals over the quadrilateral, exact by 2 x 2 Gauss points in the reference square (the
+  // integrands are at most quadratic in each reference coordinate). Domain: the corners'
+  // offsets from the point, corner c at x_p + q_c, c's bits the signs of the reference
+  // coordinates as CPDI's; kept as state variables delta_c = q_c - R_0 s_c (zero at the start,
+  // so points made anywhere start with their rectangle).
+  struct Cpdi2qShape
+  {
+    static constexpr bool tensor_product   = false;
+    static constexpr bool tracks_corners   = true;
+    static constexpr int  n_per_direction  = 2;
+    static constexpr bool folds_boundary   = false;
+    template <int dim>
+    static constexpr int domain_values = (1 << dim) * dim; // q_c, corner by corner
   };
 
   // The number of values that describe a point's domain for a shape: the half-lengths along
-  // the axes (dim) for the tensor-product shapes, R row-major (dim x dim) for CPDI.
+  // the axes (dim) for the tensor-product shapes, R row-major (dim x dim) for CPDI, the
+  // corners' offsets for CPDI2q.
   template <int dim, typename Shape>
   MPM_HOST_DEVICE constexpr int domain_values()
   {
-    return Shape::tensor_product ? dim : dim * dim;
+    if constexpr (Shape::tensor_product)
+      return dim;
+    else
+      return Shape::template domain_values<dim>;
   }
 
   // R^-T, row-major, of a dim x dim R (row-major); det R = 0 (a point crushed flat, which
@@ -69,30 +95,44 @@ namespace mpm
       }
   }
 
-  // Corner c's position in cell units along axis d, moved onto the lattice where it lies
-  // outside; sign of its k-th edge vector: bit k of c (1: +, 0: -).
+  // Corner c's offset from the point along axis d: R s_c (CPDI; bit k of c the sign of edge
+  // k: 1 +, 0 -) or the tracked corner's q_c (CPDI2q).
+  template <int dim, typename Shape, typename Real>
+  MPM_HOST_DEVICE inline Real corner_offset(const Real *domain, const int d, const int c)
+  {
+    if constexpr (Shape::tracks_corners)
+      return domain[c * dim + d];
+    else
+      {
+        Real sum = Real(0);
+        for (int k = 0; k < dim; ++k)
+          sum += ((c >> k) & 1 ? domain[d * dim + k] : -domain[d * dim + k]);
+        return sum;
+      }
+  }
+
+  // Corner c's position in cell units along axis d, moved onto the lattice where it lies outside.
   template <int dim, typename Real>
   MPM_HOST_DEVICE inline Real cpdi_corner_in_cells(const Real origin, const Real inv_h, const int n_cells,
                                                    const Real x, const Real *R, const int d, const int c)
   {
-    Real xc = x;
-    for (int k = 0; k < dim; ++k)
-      xc += ((c >> k) & 1 ? R[d * dim + k] : -R[d * dim + k]);
-    const Real s = (xc - origin) * inv_h;
+    const Real s = (x + corner_offset<dim, CpdiShape>(R, d, c) - origin) * inv_h;
     return s < Real(0) ? Real(0) : (s > Real(n_cells) ? Real(n_cells) : s);
   }
 
-  // The lattice layers along axis d that point x with domain R writes: [lo, hi].
-  template <int dim, typename Real>
+  // The lattice layers along axis d that point x with the given domain writes: [lo, hi].
+  template <int dim, typename Shape, typename Real>
   MPM_HOST_DEVICE inline void cpdi_layers(const Real origin, const Real h, const int n_cells, const Real x,
-                                          const Real *R, const int d, int &lo, int &hi)
+                                          const Real *domain, const int d, int &lo, int &hi)
   {
     const Real inv_h = Real(1) / h;
     lo               = n_cells;
     hi               = 0;
     for (int c = 0; c < (1 << dim); ++c)
       {
-        const int first = static_cast<int>(std::floor(cpdi_corner_in_cells<dim>(origin, inv_h, n_cells, x, R, d, c)));
+        Real s = (x + corner_offset<dim, Shape>(domain, d, c) - origin) * inv_h;
+        s      = s < Real(0) ? Real(0) : (s > Real(n_cells) ? Real(n_cells) : s);
+        const int first = static_cast<int>(std::floor(s));
         lo              = first < lo ? first : lo;
         hi              = first + 1 > hi ? first + 1 : hi;
       }
@@ -150,5 +190,119 @@ namespace mpm
             visit(node, share * N, static_cast<const Real *>(grad), static_cast<const Real *>(offset));
           }
       }
+  }
+
+  // CPDI2q's corner factors: wf[c] = (1/V) int Phi_c dV and wg[c] = (1/V) int grad Phi_c dV over
+  // the quadrilateral with corner offsets q (corner c at q[2c], q[2c+1]). Returns V (<= 0: the
+  // quadrilateral folded over, which the kinematics stop the run for).
+  template <typename Real>
+  MPM_HOST_DEVICE inline Real cpdi2q_corner_factors(const Real q[8], Real wf[4], Real wg[4][2])
+  {
+    const Real g   = Real(0.57735026918962576451); // 1/sqrt(3)
+    Real       V   = Real(0);
+    for (int c = 0; c < 4; ++c)
+      wf[c] = wg[c][0] = wg[c][1] = Real(0);
+    for (int k = 0; k < 4; ++k)
+      {
+        const Real xi = k & 1 ? g : -g, eta = k & 2 ? g : -g;
+        Real       phi[4], d_xi[4], d_eta[4];
+        Real       a = 0, b = 0, cc = 0, d = 0; // J = [dx/dxi dx/deta; dy/dxi dy/deta]
+        for (int c = 0; c < 4; ++c)
+          {
+            const Real sx = c & 1 ? Real(1) : Real(-1), sy = c & 2 ? Real(1) : Real(-1);
+            phi[c]   = Real(0.25) * (1 + sx * xi) * (1 + sy * eta);
+            d_xi[c]  = Real(0.25) * sx * (1 + sy * eta);
+            d_eta[c] = Real(0.25) * sy * (1 + sx * xi);
+            a += d_xi[c] * q[2 * c];
+            b += d_eta[c] * q[2 * c];
+            cc += d_xi[c] * q[2 * c + 1];
+            d += d_eta[c] * q[2 * c + 1];
+          }
+        const Real det = a * d - b * cc; // the Gauss weights are 1
+        V += det;
+        for (int c = 0; c < 4; ++c)
+          {
+            wf[c] += phi[c] * det;
+            // det J J^-T grad_xi Phi_c
+            wg[c][0] += d * d_xi[c] - cc * d_eta[c];
+            wg[c][1] += -b * d_xi[c] + a * d_eta[c];
+          }
+      }
+    const Real inv_V = V > Real(0) ? Real(1) / V : Real(0);
+    for (int c = 0; c < 4; ++c)
+      {
+        wf[c] *= inv_V;
+        wg[c][0] *= inv_V;
+        wg[c][1] *= inv_V;
+      }
+    return V;
+  }
+
+  // A corner's nodes: its cell's (the corner moved onto the lattice where it lies outside),
+  // with the linear hats' weights; visit(node, N, idx).
+  template <int dim, typename Real, typename Grid, typename Visitor>
+  MPM_HOST_DEVICE inline void visit_corner_cell(const Grid &grid, const Real xc[dim], Visitor &&visit)
+  {
+    const Real inv_h = Real(1) / grid.h;
+    int        first[dim];
+    Real       w[dim][2];
+    for (int d = 0; d < dim; ++d)
+      {
+        Real       dw[2];
+        const Real s = (xc[d] - grid.origin[d]) * inv_h;
+        LinearShape::weights_1d(s < Real(0) ? Real(0) : (s > Real(grid.n_cells[d]) ? Real(grid.n_cells[d]) : s),
+                                Real(0), first[d], w[d], dw);
+      }
+    for (int k = 0; k < (1 << dim); ++k)
+      {
+        int  idx[dim];
+        Real N = Real(1);
+        for (int d = 0; d < dim; ++d)
+          {
+            const int kd = (k >> d) & 1;
+            idx[d]       = first[d] + kd;
+            N *= w[d][kd];
+          }
+        const int node = grid.node(idx);
+        if (node >= 0)
+          visit(node, N, static_cast<const int *>(idx));
+      }
+  }
+
+  // CPDI2q's stencil, corner by corner as visit_cpdi_stencil's: visit(node, S part, grad S part,
+  // offset x_i - x_p). 2D.
+  template <int dim, typename Real, typename Grid, typename Visitor>
+  MPM_HOST_DEVICE inline void visit_cpdi2q_stencil(const Grid &grid, const Real x[dim], const Real *q, Visitor &&visit)
+  {
+    static_assert(dim == 2, "CPDI2q is two-dimensional");
+    Real wf[4], wg[4][2];
+    cpdi2q_corner_factors(q, wf, wg);
+    for (int c = 0; c < 4; ++c)
+      {
+        const Real xc[2] = {x[0] + q[2 * c], x[1] + q[2 * c + 1]};
+        visit_corner_cell<2>(grid, xc, [&](const int node, const Real N, const int *idx) {
+          Real grad[2], offset[2];
+          for (int d = 0; d < 2; ++d)
+            {
+              grad[d]   = N * wg[c][d];
+              offset[d] = grid.origin[d] + grid.h * idx[d] - x[d];
+            }
+          visit(node, wf[c] * N, static_cast<const Real *>(grad), static_cast<const Real *>(offset));
+        });
+      }
+  }
+
+  // Either CPDI's stencil (the shape's domain: R, or the corners' offsets).
+  template <int dim, typename Shape, typename Real, typename Grid, typename Visitor>
+  MPM_HOST_DEVICE inline void visit_domain_stencil(const Grid &grid, const Real x[dim], const Real *domain,
+                                                   Visitor &&visit)
+  {
+    if constexpr (Shape::tracks_corners)
+      {
+        if constexpr (dim == 2)
+          visit_cpdi2q_stencil<dim>(grid, x, domain, visit);
+      }
+    else
+      visit_cpdi_stencil<dim>(grid, x, domain, visit);
   }
 } // namespace mpm

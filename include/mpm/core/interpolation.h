@@ -120,7 +120,7 @@ namespace mpm
   // (nearly every point) the bounds are checked once per point, else per node as
   // GridView::node does. Same nodes, same order, same arithmetic for N and grad as the
   // device form.
-  template <int dim, typename Shape, typename Real>
+  template <int dim, typename Shape, typename Real, bool tensor_product = Shape::tensor_product>
   struct HostStencil
   {
     static constexpr int n = Shape::n_per_direction;
@@ -184,31 +184,32 @@ namespace mpm
     }
   };
 
-  // CPDI: the point's position and domain, its corners' weights evaluated on each visit.
-  template <int dim, typename Real>
-  struct HostStencil<dim, CpdiShape, Real>
+  // CPDI and CPDI2q: the point's position and domain, the corners' weights evaluated on each visit.
+  template <int dim, typename Shape, typename Real>
+  struct HostStencil<dim, Shape, Real, false>
   {
-    Real x[dim], R[dim * dim];
+    static constexpr int n_domain = domain_values<dim, Shape>();
+    Real                 x[dim], domain[n_domain];
 
     HostStencil() = default;
-    HostStencil(const GridView<dim, Real> &, const Real x_p[dim], const Real domain[dim * dim])
+    HostStencil(const GridView<dim, Real> &, const Real x_p[dim], const Real domain_p[])
     {
       for (int d = 0; d < dim; ++d)
         x[d] = x_p[d];
-      for (int k = 0; k < dim * dim; ++k)
-        R[k] = domain[k];
+      for (int k = 0; k < n_domain; ++k)
+        domain[k] = domain_p[k];
     }
 
     template <typename Visitor>
     void for_each(const GridView<dim, Real> &grid, Visitor &&visit) const
     {
-      visit_cpdi_stencil<dim>(grid, x, R,
-                              [&](const int node, const Real N, const Real *grad, const Real *) { visit(node, N, grad); });
+      visit_domain_stencil<dim, Shape>(
+        grid, x, domain, [&](const int node, const Real N, const Real *grad, const Real *) { visit(node, N, grad); });
     }
     template <typename Visitor>
     void for_each_with_offset(const GridView<dim, Real> &grid, const Real *, Visitor &&visit) const
     {
-      visit_cpdi_stencil<dim>(grid, x, R, visit);
+      visit_domain_stencil<dim, Shape>(grid, x, domain, visit);
     }
   };
 #endif
@@ -219,9 +220,9 @@ namespace mpm
                                                     const Real half_length[dim],
                                                     Visitor  &&visit)
   {
-    if constexpr (!Shape::tensor_product) // CPDI: half_length is the domain's R (cpdi.h)
+    if constexpr (!Shape::tensor_product) // CPDI: half_length is the domain (cpdi.h)
       {
-        visit_cpdi_stencil<dim>(grid, x, half_length,
+        visit_domain_stencil<dim, Shape>(grid, x, half_length,
                                 [&](const int node, const Real N, const Real *grad, const Real *) {
                                   visit(node, N, grad);
                                 });
@@ -325,7 +326,7 @@ namespace mpm
                                                                 const Real half_length[dim], Visitor &&visit)
   {
     if constexpr (!Shape::tensor_product)
-      visit_cpdi_stencil<dim>(grid, x, half_length, visit);
+      visit_domain_stencil<dim, Shape>(grid, x, half_length, visit);
     else
       {
         constexpr int n = Shape::n_per_direction;

@@ -19,13 +19,15 @@ namespace mpm
     gimp   = 1, // generalised interpolation MP, particle domain of half-length lp
     bspline2 = 2, // quadratic B-spline, its ghost node at a lattice face folded into the face's nodes
     bspline3 = 3, // cubic B-spline, the same fold
-    cpdi     = 4  // CPDI: linear hats averaged over a parallelogram / parallelepiped domain following F (cpdi.h)
+    cpdi     = 4, // CPDI: linear hats averaged over a parallelogram / parallelepiped domain following F (cpdi.h)
+    cpdi2q   = 5  // CPDI2q (2D): the same over a quadrilateral whose corners move with the grid (cpdi.h)
   };
 
   // Standard MPM: the two nodes of the cell containing s.
   struct LinearShape
   {
     static constexpr bool tensor_product  = true;
+    static constexpr bool tracks_corners  = false;
     static constexpr int  n_per_direction = 2;
     static constexpr bool folds_boundary  = false;
 
@@ -78,6 +80,7 @@ namespace mpm
   struct GimpShape
   {
     static constexpr bool tensor_product  = true;
+    static constexpr bool tracks_corners  = false;
     static constexpr int  n_per_direction = 3;
     static constexpr bool folds_boundary  = false; // weights beyond the lattice are zero for points inside
 
@@ -97,6 +100,7 @@ namespace mpm
   struct QuadraticBSplineShape
   {
     static constexpr bool tensor_product  = true;
+    static constexpr bool tracks_corners  = false;
     static constexpr int  n_per_direction = 3;
     static constexpr bool folds_boundary  = true;
 
@@ -136,6 +140,7 @@ namespace mpm
   struct CubicBSplineShape
   {
     static constexpr bool tensor_product  = true;
+    static constexpr bool tracks_corners  = false;
     static constexpr int  n_per_direction = 4;
     static constexpr bool folds_boundary  = true;
 

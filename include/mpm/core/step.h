@@ -103,6 +103,9 @@ namespace mpm
     // (the manufactured solutions of tests/core/manufactured_solution.h). -1: none. Host
     // backends (the state variables live on the host).
     int body_force_state_variable = -1;
+    // CPDI2q (cpdi.h): each point's corners, as their offsets from the rectangle R_0 s_c
+    // (2^dim x dim values, zero at the start) in p.state_variables[corner_state_variable + ...].
+    int corner_state_variable = -1;
   };
 
   // Per-step reductions over the points: the next time step needs the largest speed,
@@ -162,13 +165,21 @@ namespace mpm
 
   // A point's domain as the stencil reads it (domain_values<dim, Shape>() values): the
   // current half-lengths for the tensor-product shapes; CPDI's R = F R_0 (cpdi.h), R_0 the
-  // initial half-lengths on the diagonal, from the point's F of the step's start.
+  // initial half-lengths on the diagonal, from the point's F of the step's start; CPDI2q's
+  // corner offsets q_c = R_0 s_c + delta_c, delta_c from the state variables.
   template <int dim, typename Shape, typename Real>
-  MPM_HOST_DEVICE inline void load_domain(const PointsView<dim, Real> &p, const int i, Real *domain)
+  MPM_HOST_DEVICE inline void load_domain(const PointsView<dim, Real> &p, const StepSettings<dim, Real> &s,
+                                          const int i, Real *domain)
   {
     if constexpr (Shape::tensor_product)
       for (int d = 0; d < dim; ++d)
         domain[d] = p.domain_half_length[d][i];
+    else if constexpr (Shape::tracks_corners)
+      for (int c = 0; c < (1 << dim); ++c)
+        for (int d = 0; d < dim; ++d)
+          domain[c * dim + d] = ((c >> d) & 1 ? p.initial_domain_half_length[d][i] :
+                                                -p.initial_domain_half_length[d][i]) +
+                                p.state_variables[s.corner_state_variable + c * dim + d][i];
     else
       for (int a = 0; a < dim; ++a)
         for (int b = 0; b < dim; ++b)
@@ -184,7 +195,8 @@ namespace mpm
     // scatters write nodes of layers [first, first + n_per_direction - 1] and its own
     // cell, which lies in that range too. Other backends (CUDA: atomics) need nothing.
     template <int dim, typename Shape, typename Real, typename Backend>
-    void group_for_scatter(Backend &backend, const GridView<dim, Real> &g, const PointsView<dim, Real> &p)
+    void group_for_scatter(Backend &backend, const GridView<dim, Real> &g, const PointsView<dim, Real> &p,
+                           const StepSettings<dim, Real> &s)
     {
       if constexpr (colours_scatter<Backend>::value)
         {
@@ -204,11 +216,11 @@ namespace mpm
               // highest; the span is the widest of all points now (a domain stretched over
               // several cells writes several layers).
               auto layers = [&](const int i, int &lo, int &hi) {
-                Real x[dim], R[dim * dim];
+                Real x[dim], domain[domain_values<dim, Shape>()];
                 for (int d = 0; d < dim; ++d)
                   x[d] = p.position[d][i];
-                load_domain<dim, Shape>(p, i, R);
-                cpdi_layers<dim>(g.origin[axis], g.h, g.n_cells[axis], x[axis], R, axis, lo, hi);
+                load_domain<dim, Shape>(p, s, i, domain);
+                cpdi_layers<dim, Shape>(g.origin[axis], g.h, g.n_cells[axis], x[axis], domain, axis, lo, hi);
                 int cell = static_cast<int>(std::floor((x[axis] - g.origin[axis]) / g.h));
                 cell     = cell < 0 ? 0 : (cell >= g.n_cells[axis] ? g.n_cells[axis] - 1 : cell);
                 lo       = cell < lo ? cell : lo;
@@ -441,7 +453,7 @@ namespace mpm
             x[d]  = p.position[d][i];
             v[d]  = p.velocity[d][i];
           }
-        load_domain<dim, Shape>(p, i, lp);
+        load_domain<dim, Shape>(p, s, i, lp);
         const Real m = p.mass[i], V = p.volume[i];
         SymTensor<Real> sigma;
         for (int c = 0; c < n_voigt; ++c)
@@ -542,7 +554,7 @@ namespace mpm
         Real x[dim], lp[domain_values<dim, Shape>()], C[dim * dim];
         for (int d = 0; d < dim; ++d)
           x[d] = p.position[d][i];
-        load_domain<dim, Shape>(p, i, lp);
+        load_domain<dim, Shape>(p, s, i, lp);
         load_affine(p, s, i, C);
         add_apic_momentum<Backend, dim>(g, PointStencil<dim, Shape, Real>{x, lp}, x, p.mass[i], C);
       });
@@ -672,7 +684,7 @@ namespace mpm
         Real x[dim], lp[domain_values<dim, Shape>()], v_new[dim];
         for (int d = 0; d < dim; ++d)
           x[d] = p.position[d][i];
-        load_domain<dim, Shape>(p, i, lp);
+        load_domain<dim, Shape>(p, s, i, lp);
         updated_point_velocity<dim>(
           g, p, s, i, [&](auto &&visit) { for_each_stencil_node<dim, Shape>(g, x, lp, visit); }, v_new);
         for (int d = 0; d < dim; ++d)
@@ -709,7 +721,7 @@ namespace mpm
         Real x[dim], lp[domain_values<dim, Shape>()], v_new[dim], mv[dim];
         for (int d = 0; d < dim; ++d)
           x[d] = p.position[d][i];
-        load_domain<dim, Shape>(p, i, lp);
+        load_domain<dim, Shape>(p, s, i, lp);
         (void)stencils; // captured in both compilation passes (nvcc's extended lambdas need the same captures)
 #if defined(__CUDA_ARCH__) || defined(MPM_UNROLL_STENCIL)
         auto stencil = [&](auto &&visit) { for_each_stencil_node<dim, Shape>(g, x, lp, visit); };
@@ -820,7 +832,7 @@ namespace mpm
         Mat3<Real> L = Mat3<Real>::zero(); // velocity gradient; plane strain keeps row/column z zero
         for (int d = 0; d < dim; ++d)
           x[d] = p.position[d][i];
-        load_domain<dim, Shape>(p, i, lp);
+        load_domain<dim, Shape>(p, s, i, lp);
         auto visit = [&](const int n, const Real N, const Real *grad) {
           for (int d = 0; d < dim; ++d)
             {
@@ -932,6 +944,25 @@ namespace mpm
                 p.domain_half_length[d][i] = l < Real(0.5) * g.h ? l : Real(0.5) * g.h;
               }
           }
+
+        if constexpr (Shape::tracks_corners)
+          if (move)
+            {
+              // CPDI2q: each corner moves with the grid's velocity at it, kept as its offset from
+              // the point's rectangle: the point moved by dt dx above, the corner by dt v_c.
+              for (int c = 0; c < (1 << dim); ++c)
+                {
+                  Real xc[dim], vc[dim] = {};
+                  for (int d = 0; d < dim; ++d)
+                    xc[d] = x[d] + lp[c * dim + d];
+                  visit_corner_cell<dim>(g, xc, [&](const int n, const Real N, const int *) {
+                    for (int d = 0; d < dim; ++d)
+                      vc[d] += N * g.velocity[d][n];
+                  });
+                  for (int d = 0; d < dim; ++d)
+                    p.state_variables[s.corner_state_variable + c * dim + d][i] += dt * (vc[d] - dx[d]);
+                }
+            }
 
         if (leaves_grid)
           p.material[i] = -1;
@@ -1083,6 +1114,10 @@ namespace mpm
           throw std::invalid_argument("explicit_step: APIC (B D^-1) needs a shape function with a constant D_p "
                                       "(the B-splines) or linear weights; GIMP has neither (TPIC runs with it)");
       }
+    if constexpr (Shape::tracks_corners)
+      if (s.corner_state_variable < 0 || p.n_state_variables < s.corner_state_variable + (1 << dim) * dim)
+        throw std::invalid_argument("explicit_step: CPDI2q's corners need 2^dim x dim state variables "
+                                    "(StepSettings::corner_state_variable)");
     if (s.body_force_state_variable >= 0)
       {
         if (atomic_scatter<Backend>::value)
@@ -1119,7 +1154,7 @@ namespace mpm
           sum_cells(exchange, cell_sums, 2, 0);
           return;
         }
-      group_for_scatter<dim, Shape>(backend, g, p); // the points have moved
+      group_for_scatter<dim, Shape>(backend, g, p, s); // the points have moved
       scatter_cell_pressure(backend, g, p, exchange);
     };
     // Atomic backends add the affine transfers' momentum in a pass of its own, after each P2G of
@@ -1129,7 +1164,7 @@ namespace mpm
         if (s.affine_state_variable >= 0)
           add_affine_momentum<dim, Shape>(backend, g, p, s);
     };
-    group_for_scatter<dim, Shape>(backend, g, p);
+    group_for_scatter<dim, Shape>(backend, g, p, s);
     switch (s.scheme)
       {
         case UpdateScheme::musl:
@@ -1218,6 +1253,14 @@ namespace mpm
       return explicit_step<dim, CubicBSplineShape, physics>(backend, g, p, materials, s, dt, exchange, averaging_pending);
     if (shape == ShapeFunction::cpdi)
       return explicit_step<dim, CpdiShape, physics>(backend, g, p, materials, s, dt, exchange, averaging_pending);
+    if (shape == ShapeFunction::cpdi2q)
+      {
+        if constexpr (dim == 2)
+          return explicit_step<dim, Cpdi2qShape, physics>(backend, g, p, materials, s, dt, exchange,
+                                                          averaging_pending);
+        else
+          throw std::invalid_argument("explicit_step: CPDI2q is two-dimensional");
+      }
     return explicit_step<dim, LinearShape, physics>(backend, g, p, materials, s, dt, exchange, averaging_pending);
   }
 } // namespace mpm

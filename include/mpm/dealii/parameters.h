@@ -148,6 +148,9 @@ namespace mpm
     // Velocity transfer = APIC: the index of the first of the dim x dim state variables that hold
     // each point's affine matrix (after the models' own); -1 otherwise.
     int affine_state_variable() const;
+    // Shape function = CPDI2q: the index of the first of the 4 x dim state variables that hold each
+    // point's corners (their offsets from the initial rectangle; after the affine matrix); -1 otherwise.
+    int corner_state_variable() const;
 
     // Declares every entry for a given dimension, number of bodies and material names.
     static void declare(dealii::ParameterHandler &prm, unsigned int dim, unsigned int n_bodies,
