@@ -372,6 +372,18 @@ int main()
   check_cpdi<2>(rng);
   check_cpdi<3>(rng);
   check_cpdi2q(rng);
+  {
+    // A folded quadrilateral (two corners swapped: V <= 0) and a flat CPDI domain (det R = 0):
+    // NaN weights, so the run stops with the instability message, never a point without mass.
+    const double folded[8] = {-0.1, -0.1, 0.1, 0.1, -0.1, 0.1, 0.1, -0.1};
+    double       wf[4], wg[4][2];
+    const double V = cpdi2q_corner_factors(folded, wf, wg);
+    mpm_test::check(V <= 0 && std::isnan(wf[0]) && std::isnan(wg[0][0]), "CPDI2q: a folded quadrilateral gives NaN");
+    const double flat[4] = {0.1, 0.2, 0.05, 0.1}; // columns parallel
+    double       inv_t[4];
+    inverse_transpose<2>(flat, inv_t);
+    mpm_test::check(std::isnan(inv_t[0]), "CPDI: a flat domain gives NaN gradients");
+  }
 
   // An axis-aligned domain inside a cell: uGIMP's weights (both the hat's exact average there).
   HostGrid<2, double> grid;

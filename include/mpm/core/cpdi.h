@@ -16,6 +16,8 @@
 #include <mpm/core/config.h>
 #include <mpm/core/shape_functions.h>
 
+#include <cmath>
+
 namespace mpm
 {
   struct CpdiShape
@@ -61,15 +63,16 @@ namespace mpm
       return Shape::template domain_values<dim>;
   }
 
-  // R^-T, row-major, of a dim x dim R (row-major); det R = 0 (a point crushed flat, which
-  // the step's checks on det F report) gives zeros, not infinities.
+  // R^-T, row-major, of a dim x dim R (row-major). det R = 0 (a point crushed flat) gives NaN:
+  // the point's gradients are then not finite, and the run stops with the instability message
+  // that names it (the step's speed check), instead of going on without its forces.
   template <int dim, typename Real>
   MPM_HOST_DEVICE inline void inverse_transpose(const Real *R, Real inv_t[dim * dim])
   {
     if constexpr (dim == 2)
       {
         const Real det = R[0] * R[3] - R[1] * R[2];
-        const Real s   = det != Real(0) ? Real(1) / det : Real(0);
+        const Real s   = det != Real(0) ? Real(1) / det : Real(NAN);
         inv_t[0]       = R[3] * s;
         inv_t[1]       = -R[2] * s;
         inv_t[2]       = -R[1] * s;
@@ -89,7 +92,7 @@ namespace mpm
         cof[7]         = R[2] * R[3] - R[0] * R[5];
         cof[8]         = R[0] * R[4] - R[1] * R[3];
         const Real det = R[0] * cof[0] + R[1] * cof[1] + R[2] * cof[2];
-        const Real s   = det != Real(0) ? Real(1) / det : Real(0);
+        const Real s   = det != Real(0) ? Real(1) / det : Real(NAN);
         for (int k = 0; k < 9; ++k)
           inv_t[k] = cof[k] * s;
       }
@@ -111,15 +114,6 @@ namespace mpm
       }
   }
 
-  // Corner c's position in cell units along axis d, moved onto the lattice where it lies outside.
-  template <int dim, typename Real>
-  MPM_HOST_DEVICE inline Real cpdi_corner_in_cells(const Real origin, const Real inv_h, const int n_cells,
-                                                   const Real x, const Real *R, const int d, const int c)
-  {
-    const Real s = (x + corner_offset<dim, CpdiShape>(R, d, c) - origin) * inv_h;
-    return s < Real(0) ? Real(0) : (s > Real(n_cells) ? Real(n_cells) : s);
-  }
-
   // The lattice layers along axis d that point x with the given domain writes: [lo, hi].
   template <int dim, typename Shape, typename Real>
   MPM_HOST_DEVICE inline void cpdi_layers(const Real origin, const Real h, const int n_cells, const Real x,
@@ -131,10 +125,43 @@ namespace mpm
     for (int c = 0; c < (1 << dim); ++c)
       {
         Real s = (x + corner_offset<dim, Shape>(domain, d, c) - origin) * inv_h;
-        s      = s < Real(0) ? Real(0) : (s > Real(n_cells) ? Real(n_cells) : s);
+        s      = s >= Real(0) ? (s > Real(n_cells) ? Real(n_cells) : s) : Real(0); // NaN: 0
         const int first = static_cast<int>(std::floor(s));
         lo              = first < lo ? first : lo;
         hi              = first + 1 > hi ? first + 1 : hi;
+      }
+  }
+
+  // A corner's nodes: its cell's (the corner moved onto the lattice where it lies outside),
+  // with the linear hats' weights; visit(node, N, idx).
+  template <int dim, typename Real, typename Grid, typename Visitor>
+  MPM_HOST_DEVICE inline void visit_corner_cell(const Grid &grid, const Real xc[dim], Visitor &&visit)
+  {
+    const Real inv_h = Real(1) / grid.h;
+    int        first[dim];
+    Real       w[dim][2];
+    for (int d = 0; d < dim; ++d)
+      {
+        Real       dw[2];
+        const Real s = (xc[d] - grid.origin[d]) * inv_h;
+        // onto the lattice; a NaN corner (a run about to stop) onto its origin, whose weights stay
+        // finite while the NaN reaches the values through the corner's factors
+        LinearShape::weights_1d(s >= Real(0) ? (s > Real(grid.n_cells[d]) ? Real(grid.n_cells[d]) : s) : Real(0),
+                                Real(0), first[d], w[d], dw);
+      }
+    for (int k = 0; k < (1 << dim); ++k)
+      {
+        int  idx[dim];
+        Real N = Real(1);
+        for (int d = 0; d < dim; ++d)
+          {
+            const int kd = (k >> d) & 1;
+            idx[d]       = first[d] + kd;
+            N *= w[d][kd];
+          }
+        const int node = grid.node(idx);
+        if (node >= 0)
+          visit(node, N, static_cast<const int *>(idx));
       }
   }
 
@@ -145,8 +172,6 @@ namespace mpm
   MPM_HOST_DEVICE inline void visit_cpdi_stencil(const Grid &grid, const Real x[dim], const Real *R, Visitor &&visit)
   {
     constexpr int n_corners = 1 << dim;
-    constexpr int n_nodes   = 1 << dim;
-    const Real    inv_h     = Real(1) / grid.h;
     const Real    share     = Real(1) / Real(n_corners);
     Real          inv_t[dim * dim];
     inverse_transpose<dim>(R, inv_t);
@@ -160,41 +185,25 @@ namespace mpm
               sum += ((c >> k) & 1 ? inv_t[a * dim + k] : -inv_t[a * dim + k]);
             corner_grad[a] = share * sum;
           }
-        int  first[dim];
-        Real w[dim][2];
+        Real xc[dim];
         for (int d = 0; d < dim; ++d)
-          {
-            Real dw[2];
-            LinearShape::weights_1d(cpdi_corner_in_cells<dim>(grid.origin[d], inv_h, grid.n_cells[d], x[d], R, d, c),
-                                    Real(0), first[d], w[d], dw);
-          }
-        for (int k = 0; k < n_nodes; ++k)
-          {
-            int  idx[dim];
-            Real N = Real(1);
-            for (int d = 0; d < dim; ++d)
-              {
-                const int kd = (k >> d) & 1;
-                idx[d]       = first[d] + kd;
-                N *= w[d][kd];
-              }
-            const int node = grid.node(idx);
-            if (node < 0)
-              continue;
-            Real grad[dim], offset[dim];
-            for (int d = 0; d < dim; ++d)
-              {
-                grad[d]   = N * corner_grad[d];
-                offset[d] = grid.origin[d] + grid.h * idx[d] - x[d];
-              }
-            visit(node, share * N, static_cast<const Real *>(grad), static_cast<const Real *>(offset));
-          }
+          xc[d] = x[d] + corner_offset<dim, CpdiShape>(R, d, c);
+        visit_corner_cell<dim>(grid, xc, [&](const int node, const Real N, const int *idx) {
+          Real grad[dim], offset[dim];
+          for (int d = 0; d < dim; ++d)
+            {
+              grad[d]   = N * corner_grad[d];
+              offset[d] = grid.origin[d] + grid.h * idx[d] - x[d];
+            }
+          visit(node, share * N, static_cast<const Real *>(grad), static_cast<const Real *>(offset));
+        });
       }
   }
 
   // CPDI2q's corner factors: wf[c] = (1/V) int Phi_c dV and wg[c] = (1/V) int grad Phi_c dV over
-  // the quadrilateral with corner offsets q (corner c at q[2c], q[2c+1]). Returns V (<= 0: the
-  // quadrilateral folded over, which the kinematics stop the run for).
+  // the quadrilateral with corner offsets q (corner c at q[2c], q[2c+1]). Returns V. V <= 0 (the
+  // quadrilateral folded over) gives NaN factors: the run stops with the instability message that
+  // names the point (the step's speed check), instead of going on without its mass.
   template <typename Real>
   MPM_HOST_DEVICE inline Real cpdi2q_corner_factors(const Real q[8], Real wf[4], Real wg[4][2])
   {
@@ -228,7 +237,7 @@ namespace mpm
             wg[c][1] += -b * d_xi[c] + a * d_eta[c];
           }
       }
-    const Real inv_V = V > Real(0) ? Real(1) / V : Real(0);
+    const Real inv_V = V > Real(0) ? Real(1) / V : Real(NAN);
     for (int c = 0; c < 4; ++c)
       {
         wf[c] *= inv_V;
@@ -236,37 +245,6 @@ namespace mpm
         wg[c][1] *= inv_V;
       }
     return V;
-  }
-
-  // A corner's nodes: its cell's (the corner moved onto the lattice where it lies outside),
-  // with the linear hats' weights; visit(node, N, idx).
-  template <int dim, typename Real, typename Grid, typename Visitor>
-  MPM_HOST_DEVICE inline void visit_corner_cell(const Grid &grid, const Real xc[dim], Visitor &&visit)
-  {
-    const Real inv_h = Real(1) / grid.h;
-    int        first[dim];
-    Real       w[dim][2];
-    for (int d = 0; d < dim; ++d)
-      {
-        Real       dw[2];
-        const Real s = (xc[d] - grid.origin[d]) * inv_h;
-        LinearShape::weights_1d(s < Real(0) ? Real(0) : (s > Real(grid.n_cells[d]) ? Real(grid.n_cells[d]) : s),
-                                Real(0), first[d], w[d], dw);
-      }
-    for (int k = 0; k < (1 << dim); ++k)
-      {
-        int  idx[dim];
-        Real N = Real(1);
-        for (int d = 0; d < dim; ++d)
-          {
-            const int kd = (k >> d) & 1;
-            idx[d]       = first[d] + kd;
-            N *= w[d][kd];
-          }
-        const int node = grid.node(idx);
-        if (node >= 0)
-          visit(node, N, static_cast<const int *>(idx));
-      }
   }
 
   // CPDI2q's stencil, corner by corner as visit_cpdi_stencil's: visit(node, S part, grad S part,
