@@ -245,21 +245,21 @@ namespace mpm
             }
           else
             {
-          constexpr int n    = Shape::n_per_direction;
-          constexpr int span = n == 2 ? 3 : n;
-          const Real    inv_h = Real(1) / g.h;
-          backend.group_points(p.n_points, g.n_cells[axis] + 1, span, [&](const int i) {
-            if (p.material[i] < 0)
-              return -1;
-            int        first;
-            Real       w[n], dw[n];
-            const Real x = p.position[axis][i];
-            Shape::weights_1d((x - g.origin[axis]) * inv_h, p.domain_half_length[axis][i] * inv_h, first, w, dw);
-            int cell = static_cast<int>(std::floor((x - g.origin[axis]) / g.h));
-            cell     = cell < 0 ? 0 : (cell >= g.n_cells[axis] ? g.n_cells[axis] - 1 : cell);
-            const int key = first < cell ? first : cell;
-            return key < 0 ? 0 : key;
-          });
+              constexpr int n    = Shape::n_per_direction;
+              constexpr int span = n == 2 ? 3 : n;
+              const Real    inv_h = Real(1) / g.h;
+              backend.group_points(p.n_points, g.n_cells[axis] + 1, span, [&](const int i) {
+                if (p.material[i] < 0)
+                  return -1;
+                int        first;
+                Real       w[n], dw[n];
+                const Real x = p.position[axis][i];
+                Shape::weights_1d((x - g.origin[axis]) * inv_h, p.domain_half_length[axis][i] * inv_h, first, w, dw);
+                int cell = static_cast<int>(std::floor((x - g.origin[axis]) / g.h));
+                cell     = cell < 0 ? 0 : (cell >= g.n_cells[axis] ? g.n_cells[axis] - 1 : cell);
+                const int key = first < cell ? first : cell;
+                return key < 0 ? 0 : key;
+              });
             }
         }
     }
