@@ -120,6 +120,7 @@ namespace mpm
   // (nearly every point) the bounds are checked once per point, else per node as
   // GridView::node does. Same nodes, same order, same arithmetic for N and grad as the
   // device form.
+  // (tensor_product: chosen from the shape; CPDI and CPDI2q use the specialisation below.)
   template <int dim, typename Shape, typename Real, bool tensor_product = Shape::tensor_product>
   struct HostStencil
   {
