@@ -100,6 +100,8 @@ namespace mpm
             this->near_material.lattice_friction_faces   = lattice.friction_faces;
             view.lattice_to_node     = nullptr;
             view.n_nodes             = 0; // (the friction coefficients are taken, the masks later)
+            for (int d = 0; d < dim; ++d)
+              view.box_nodes[d] = 0;
           }
         device = std::make_unique<cuda::DeviceEngine<dim>>(view, materials, shape, nullptr);
       }
@@ -108,8 +110,11 @@ namespace mpm
       {
         auto &near = this->near_material;
         if (this->follows_material())
-          near.kept(device->keep_nodes_near_points(near.block_cells, near.lattice_fixed_components,
-                                                   near.lattice_friction_faces));
+          {
+            const int n_kept = device->keep_nodes_near_points(near.block_cells, near.lattice_fixed_components,
+                                                              near.lattice_friction_faces);
+            near.kept(n_kept, device->kept_nodes_are_box()); // asked after the choice
+          }
       }
 
       void cells_with_mass(typename GridSnapshot<dim>::LatticeCells &out) override

@@ -382,16 +382,14 @@ namespace mpm
       // between re-sorts.
       ResortScratch                resort;
       SlotScratch                  slot_scratch;
-      // The device's nodes: lattice order from lattice index node_offset on; the device
-      // index of each host node (-1: not in the lattice).
-      long                         node_offset = 0;
+      // The device index of each host node (-1: not in the lattice).
       std::vector<int>             slab_of_host;
       // The last step's pressure averaging is left to the next step's P2G (explicit_step);
       // download_points finishes it first.
       bool                         averaging_pending = false;
-      // Nodes near the points (keep_nodes_near_points): the lattice index of each device
-      // node (empty: the slab from node_offset on), the lookup on the host, and the cell sums
-      // at the nodes.
+      // Nodes near the points (keep_nodes_near_points) through a lookup: the lattice index of
+      // each device node and the lookup on the host (both empty where the nodes are a box of
+      // the lattice: grid.box_lower, box_nodes), and the cell sums at the nodes.
       std::vector<long>            lattice_of_node;
       std::vector<int>             lattice_to_node;
       bool                         cell_sums_at_nodes = false;
@@ -409,6 +407,24 @@ namespace mpm
 
       // Entries of the pressure averaging's cell sums: one per lattice cell, or per node.
       long n_cell_sums() const { return cell_sums_at_nodes ? grid.n_nodes() : n_lattice_cells; }
+
+      // The box the device's nodes are, where they have no lookup.
+      NodeBox<dim> node_box() const
+      {
+        NodeBox<dim> box;
+        for (int d = 0; d < dim; ++d)
+          {
+            box.lower[d] = grid.box_lower[d];
+            box.nodes[d] = grid.box_nodes[d];
+          }
+        return box;
+      }
+
+      // Lattice index of device node b.
+      long lattice_of_device_node(const long b) const
+      {
+        return lattice_of_node.empty() ? node_box().lattice_of(b, grid.n_cells) : lattice_of_node[b];
+      }
 
       // Applies the last step's averaging if the next step's P2G was to do it.
       void finish_pending_averaging()
@@ -471,7 +487,6 @@ namespace mpm
       const long n_slab      = first < 0 ? 0 : (last / layer + 1) * layer - node_offset;
       if (n_slab > std::numeric_limits<int>::max())
         throw std::invalid_argument("DeviceEngine: more lattice nodes in the rank's slab than an int can count");
-      impl->node_offset = node_offset;
       impl->slab_of_host.resize(g.n_nodes);
       for (int node = 0; node < g.n_nodes; ++node)
         impl->slab_of_host[node] = lattice_of_host[node] < 0 ? -1 : static_cast<int>(lattice_of_host[node] - node_offset);
@@ -489,8 +504,14 @@ namespace mpm
           for (int f = 0; f < 2 * dim; ++f)
             host.friction_coefficient[f] = g.friction_coefficient[f];
         }
-      impl->grid.upload(host); // no lookup: lattice order from node_offset on
-      impl->grid.node_offset = node_offset;
+      impl->grid.upload(host);
+      int slab_lower[dim], slab_nodes[dim]; // no lookup: the slab's layers, lattice order
+      for (int d = 0; d < dim; ++d)
+        {
+          slab_lower[d] = d < dim - 1 ? 0 : static_cast<int>(node_offset / layer);
+          slab_nodes[d] = d < dim - 1 ? g.n_cells[d] + 1 : static_cast<int>(n_slab / layer);
+        }
+      impl->grid.set_box(slab_lower, slab_nodes);
       impl->materials.upload(materials);
       impl->hencky = uses_hencky(materials);
       impl->exchange = ExchangeAdapter{exchange, &impl->backend, &impl->exchanged_nodes, &impl->exchanged_cells};
@@ -547,13 +568,12 @@ namespace mpm
       for (int d = 0; d < dim; ++d)
         if (g.n_cells[d] != dg.n_cells[d])
           throw std::invalid_argument("DeviceEngine::download_nodal: the host grid has another lattice");
-      // Device node b is lattice node node_offset + b, which is the host's node of that
-      // lattice index (absent from the host: not written).
+      // Device node b is the host's node of its lattice index (absent from the host: not
+      // written).
       std::vector<double> staging(dg.mass.size());
       std::vector<int>    host_node(staging.size());
       for (size_t b = 0; b < host_node.size(); ++b)
-        host_node[b] = g.node_of_lattice(impl->lattice_of_node.empty() ? impl->node_offset + static_cast<long>(b) :
-                                                                         impl->lattice_of_node[b]);
+        host_node[b] = g.node_of_lattice(impl->lattice_of_device_node(static_cast<long>(b)));
       auto download = [&](double *to, const DeviceArray<double> &from) {
         from.download(staging);
         for (size_t b = 0; b < staging.size(); ++b)
@@ -907,18 +927,31 @@ namespace mpm
       impl->home_by_slot_stale = true;
       std::vector<std::uint8_t> holding;
       impl->block_marks.download(holding);
-      ActiveNodes active = nodes_of_blocks<dim>(g.n_cells, block_cells, std::move(holding));
+      const std::vector<std::uint8_t> kept = kept_blocks<dim>(g.n_cells, block_cells, std::move(holding));
+      NodeBox<dim>                    box;
+      ActiveNodes                     active;
+      const bool                      as_box = box_of_kept_blocks<dim>(g.n_cells, block_cells, kept, box);
+      if (!as_box)
+        active = nodes_of_kept_blocks<dim>(g.n_cells, block_cells, kept);
+      auto lattice_of = [&](const long node) {
+        return as_box ? box.lattice_of(node, g.n_cells) : active.lattice_of_node[node];
+      };
 
-      const long                n_nodes = static_cast<long>(active.lattice_of_node.size());
+      const long n_nodes = as_box ? box.size() : static_cast<long>(active.lattice_of_node.size());
+      if (n_nodes > std::numeric_limits<int>::max())
+        throw std::invalid_argument("DeviceEngine: more nodes near the points than an int can count");
       std::vector<std::uint8_t> node_fixed(n_nodes), node_friction(friction.empty() ? 0 : n_nodes);
       for (long node = 0; node < n_nodes; ++node)
         {
-          node_fixed[node] = fixed[active.lattice_of_node[node]];
+          const long lattice = lattice_of(node);
+          node_fixed[node]   = fixed[lattice];
           if (!friction.empty())
-            node_friction[node] = friction[active.lattice_of_node[node]];
+            node_friction[node] = friction[lattice];
         }
-      impl->grid.set_nodes(active.lattice_to_node, node_fixed, node_friction);
-      impl->node_offset        = 0;
+      if (as_box)
+        impl->grid.set_box(box.lower, box.nodes, node_fixed, node_friction);
+      else
+        impl->grid.set_nodes(active.lattice_to_node, node_fixed, node_friction);
       impl->lattice_to_node    = std::move(active.lattice_to_node);
       impl->lattice_of_node    = std::move(active.lattice_of_node);
       impl->cell_sums_at_nodes = true;
@@ -941,11 +974,26 @@ namespace mpm
           nodes.origin[d]  = dg.origin[d];
           nodes.n_cells[d] = dg.n_cells[d];
         }
-      nodes.lattice_to_node = impl->lattice_to_node;
-      lattice_of_node       = impl->lattice_of_node;
+      if (impl->lattice_of_node.empty()) // a box: its lookup made here
+        {
+          ActiveNodes box_nodes = nodes_of_box<dim>(dg.n_cells, impl->node_box());
+          nodes.lattice_to_node = std::move(box_nodes.lattice_to_node);
+          lattice_of_node       = std::move(box_nodes.lattice_of_node);
+        }
+      else
+        {
+          nodes.lattice_to_node = impl->lattice_to_node;
+          lattice_of_node       = impl->lattice_of_node;
+        }
       dg.mass.download(nodes.mass);
       for (int d = 0; d < dim; ++d)
         dg.velocity[d].download(nodes.velocity[d]);
+    }
+
+    template <int dim>
+    bool DeviceEngine<dim>::kept_nodes_are_box() const
+    {
+      return impl->grid.lattice_order;
     }
 
     template class DeviceEngine<2>;

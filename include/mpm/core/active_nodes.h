@@ -63,20 +63,19 @@ namespace mpm
     return n;
   }
 
-  // The active nodes from the blocks that hold a point's cell (holding[b] != 0, one entry per
-  // block): those blocks and their neighbours are kept, and the vertices of their cells.
+  // The blocks kept for the blocks that hold a point's cell (holding[b] != 0, one entry per
+  // block): those blocks and their neighbours.
   template <int dim>
-  ActiveNodes nodes_of_blocks(const int n_cells[dim], const int block_cells, std::vector<std::uint8_t> holding)
+  std::vector<std::uint8_t> kept_blocks(const int n_cells[dim], const int block_cells,
+                                        std::vector<std::uint8_t> holding)
   {
-    long n_block[dim], total_blocks = 1, n_lattice_nodes = 1, node_stride[dim];
+    long n_block[dim], total_blocks = 1;
     for (int d = 0; d < dim; ++d)
       {
-        n_block[d]     = n_blocks_along<dim>(n_cells[d], block_cells);
-        node_stride[d] = n_lattice_nodes;
+        n_block[d] = n_blocks_along<dim>(n_cells[d], block_cells);
         total_blocks *= n_block[d];
-        n_lattice_nodes *= n_cells[d] + 1;
       }
-    // The neighbours: the mask dilated by one block along each axis in turn.
+    // The mask dilated by one block along each axis in turn.
     long stride = 1;
     for (int d = 0; d < dim; ++d)
       {
@@ -90,12 +89,28 @@ namespace mpm
         holding.swap(grown);
         stride *= n_block[d];
       }
+    return holding;
+  }
+
+  // The vertices of the kept blocks' cells (kept[b] != 0), numbered in lattice order.
+  template <int dim>
+  ActiveNodes nodes_of_kept_blocks(const int n_cells[dim], const int block_cells,
+                                   const std::vector<std::uint8_t> &kept_block)
+  {
+    long n_block[dim], total_blocks = 1, n_lattice_nodes = 1, node_stride[dim];
+    for (int d = 0; d < dim; ++d)
+      {
+        n_block[d]     = n_blocks_along<dim>(n_cells[d], block_cells);
+        node_stride[d] = n_lattice_nodes;
+        total_blocks *= n_block[d];
+        n_lattice_nodes *= n_cells[d] + 1;
+      }
     // The vertices of a kept block's cells: lattice nodes B b .. B (b + 1) along each axis
     // (clipped to the lattice), marked, then numbered in lattice order.
     std::vector<std::uint8_t> kept(n_lattice_nodes, 0);
     for (long b = 0; b < total_blocks; ++b)
       {
-        if (!holding[b])
+        if (!kept_block[b])
           continue;
         int  lower[dim], upper[dim], idx[dim];
         long rest = b;
@@ -129,6 +144,107 @@ namespace mpm
           nodes.lattice_to_node[l] = static_cast<int>(nodes.lattice_of_node.size());
           nodes.lattice_of_node.push_back(l);
         }
+    return nodes;
+  }
+
+  // The active nodes from the blocks that hold a point's cell: the vertices of those blocks'
+  // and their neighbours' cells.
+  template <int dim>
+  ActiveNodes nodes_of_blocks(const int n_cells[dim], const int block_cells, std::vector<std::uint8_t> holding)
+  {
+    return nodes_of_kept_blocks<dim>(n_cells, block_cells, kept_blocks<dim>(n_cells, block_cells, std::move(holding)));
+  }
+
+  // A box of lattice nodes: lower[d] .. lower[d] + nodes[d] - 1 along each axis.
+  template <int dim>
+  struct NodeBox
+  {
+    int lower[dim] = {};
+    int nodes[dim] = {};
+
+    long size() const
+    {
+      long n = 1;
+      for (int d = 0; d < dim; ++d)
+        n *= nodes[d];
+      return n;
+    }
+
+    // Lattice index of the box's node b (x fastest in both).
+    long lattice_of(long b, const int n_cells[dim]) const
+    {
+      long lattice = 0, stride = 1;
+      for (int d = 0; d < dim; ++d)
+        {
+          lattice += (lower[d] + b % nodes[d]) * stride;
+          b /= nodes[d];
+          stride *= n_cells[d] + 1;
+        }
+      return lattice;
+    }
+  };
+
+  // A device grid numbers the kept nodes as the box around them, with no lookup (which cost
+  // 4% of P2's step), where that box holds at most this many times the kept blocks: the
+  // nodes between the kept blocks cost memory and the grid passes, not point work.
+  constexpr long box_blocks_per_kept_block = 2;
+
+  // The box of the vertices of the kept blocks' cells (kept[b] != 0), and whether it is
+  // compact enough to number the nodes by (box_blocks_per_kept_block). No block kept: an
+  // empty box.
+  template <int dim>
+  bool box_of_kept_blocks(const int n_cells[dim], const int block_cells, const std::vector<std::uint8_t> &kept,
+                          NodeBox<dim> &box)
+  {
+    long n_block[dim], lo[dim], hi[dim], n_kept = 0;
+    for (int d = 0; d < dim; ++d)
+      {
+        n_block[d] = n_blocks_along<dim>(n_cells[d], block_cells);
+        lo[d]      = n_block[d];
+        hi[d]      = -1;
+      }
+    for (long b = 0; b < static_cast<long>(kept.size()); ++b)
+      if (kept[b])
+        {
+          ++n_kept;
+          long rest = b;
+          for (int d = 0; d < dim; ++d)
+            {
+              const long i = rest % n_block[d];
+              rest /= n_block[d];
+              lo[d] = i < lo[d] ? i : lo[d];
+              hi[d] = i > hi[d] ? i : hi[d];
+            }
+        }
+    box = NodeBox<dim>();
+    if (n_kept == 0)
+      return true;
+    long n_box_blocks = 1;
+    for (int d = 0; d < dim; ++d)
+      {
+        const long upper = (hi[d] + 1) * block_cells < n_cells[d] ? (hi[d] + 1) * block_cells : n_cells[d];
+        box.lower[d]     = static_cast<int>(lo[d] * block_cells);
+        box.nodes[d]     = static_cast<int>(upper - box.lower[d] + 1);
+        n_box_blocks *= hi[d] - lo[d] + 1;
+      }
+    return n_box_blocks <= box_blocks_per_kept_block * n_kept;
+  }
+
+  // The lookup of a box's nodes and its inverse (output, tests).
+  template <int dim>
+  ActiveNodes nodes_of_box(const int n_cells[dim], const NodeBox<dim> &box)
+  {
+    long n_lattice_nodes = 1;
+    for (int d = 0; d < dim; ++d)
+      n_lattice_nodes *= n_cells[d] + 1;
+    ActiveNodes nodes;
+    nodes.lattice_to_node.assign(n_lattice_nodes, -1);
+    nodes.lattice_of_node.resize(box.size());
+    for (long b = 0; b < box.size(); ++b)
+      {
+        nodes.lattice_of_node[b]                        = box.lattice_of(b, n_cells);
+        nodes.lattice_to_node[nodes.lattice_of_node[b]] = static_cast<int>(b);
+      }
     return nodes;
   }
 

@@ -162,6 +162,7 @@ namespace mpm
       }
     v.h                = s.h;
     v.lattice_to_node  = s.lattice_to_node.data();
+    v.box_is_lattice(); // where the owner has no lookup
     v.n_nodes          = static_cast<int>(s.mass.size());
     v.mass             = s.mass.data();
     v.fixed_components = s.fixed_components.data();

@@ -65,21 +65,32 @@ namespace mpm
     return stencil_weight_at<dim>(wk, dwk, inv_h, grad);
   }
 
-  // Lattice strides (x fastest, as GridView::node) and the lattice index of the stencil's
-  // first node; returns whether the whole stencil of n nodes per direction lies inside the
-  // lattice (then node indices are base + offsets, with no bounds check per node).
+  // Strides (x fastest, as GridView::node) and the index of the stencil's first node in the
+  // numbering the grid computes nodes in: the lattice's (with a lookup) or its box's (without);
+  // returns whether the whole stencil of n nodes per direction lies inside the lattice or
+  // the box (then the node of stencil offset o is grid.node_at(base + o), with no bounds
+  // check per node).
   template <int dim, int n, typename Real>
   MPM_HOST_DEVICE inline bool stencil_base(const GridView<dim, Real> &grid, const int first[dim], long stride[dim],
                                            long &base)
   {
     bool inside = true;
     base        = 0;
-    for (int d = 0; d < dim; ++d)
-      {
-        stride[d] = d == 0 ? 1 : stride[d - 1] * (grid.n_cells[d - 1] + 1);
-        base += first[d] * stride[d];
-        inside = inside && first[d] >= 0 && first[d] + n - 1 <= grid.n_cells[d];
-      }
+    if (grid.lattice_to_node != nullptr)
+      for (int d = 0; d < dim; ++d)
+        {
+          stride[d] = d == 0 ? 1 : stride[d - 1] * (grid.n_cells[d - 1] + 1);
+          base += first[d] * stride[d];
+          inside = inside && first[d] >= 0 && first[d] + n - 1 <= grid.n_cells[d];
+        }
+    else
+      for (int d = 0; d < dim; ++d)
+        {
+          stride[d]      = d == 0 ? 1 : stride[d - 1] * grid.box_nodes[d - 1];
+          const int from = first[d] - grid.box_lower[d];
+          base += from * stride[d];
+          inside = inside && from >= 0 && from + n <= grid.box_nodes[d];
+        }
     return inside;
   }
 
@@ -158,7 +169,7 @@ namespace mpm
               long      offset = 0;
               for (int d = 0; d < dim; ++d)
                 offset += k[d] * stride[d];
-              const int node = grid.node_of_lattice(base + offset);
+              const int node = grid.node_at(base + offset);
               if (node >= 0) // absent from this rank's node set
                 visit_position(s, node);
             }
@@ -268,7 +279,7 @@ namespace mpm
           long offset = 0;
           for (int d = 0; d < dim; ++d)
             offset += k[d] * stride[d];
-          return grid.node_of_lattice(base + offset);
+          return grid.node_at(base + offset);
         }
       int idx[dim];
       for (int d = 0; d < dim; ++d)

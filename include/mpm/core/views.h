@@ -28,20 +28,23 @@ namespace mpm
     return cell;
   }
 
-  // Uniform background lattice; nodes are reached through a lookup so that the
-  // node numbering can be deal.II's locally relevant DoF space (and later sparse).
+  // Uniform background lattice. Its nodes are numbered in one of two ways: through a
+  // lookup (deal.II's locally relevant DoF space, the nodes near the material), or, with
+  // no lookup, as a box of the lattice in lattice order (device grids: the whole lattice,
+  // a rank's slab, the box around the material), whose index is computed, not looked up.
   template <int dim, typename Real>
   struct GridView
   {
     Real origin[dim];           // lower corner of the grid
     Real h;                     // cell size, equal in every direction
     int  n_cells[dim];          // cells per direction
-    // Lattice index -> local node index, -1 if absent. Null: the nodes are a slab of the
-    // lattice in lattice order, no lookup needed (device grids): node = lattice index -
-    // node_offset, and a lattice index outside the slab is absent.
+    // Lattice index -> local node index, -1 if absent. Null: the nodes are the box of
+    // lattice nodes box_lower[d] .. box_lower[d] + box_nodes[d] - 1 along each axis, x
+    // fastest, and a lattice node outside the box is absent.
     const int *lattice_to_node;
-    int        n_nodes;         // local nodes (length of the arrays below)
-    long       node_offset = 0; // without a lookup: lattice index of node 0
+    int        n_nodes;             // local nodes (length of the arrays below)
+    int        box_lower[dim] = {}; // without a lookup: the box's first lattice node
+    int        box_nodes[dim] = {}; // and its nodes along each axis (inside the lattice)
 
     Real *mass;
     Real *momentum[dim];
@@ -86,19 +89,20 @@ namespace mpm
     {
       if (!cell_sums_at_nodes)
         return lattice_cell(x);
-      long lattice = 0;
-      for (int d = dim - 1; d >= 0; --d)
+      int idx[dim];
+      for (int d = 0; d < dim; ++d)
         {
-          long i  = static_cast<long>(std::floor((x[d] - origin[d]) / h));
-          i       = i < 0 ? 0 : (i >= n_cells[d] ? n_cells[d] - 1 : i);
-          lattice = lattice * (n_cells[d] + 1) + i;
+          const long i = static_cast<long>(std::floor((x[d] - origin[d]) / h));
+          idx[d]       = static_cast<int>(i < 0 ? 0 : (i >= n_cells[d] ? n_cells[d] - 1 : i));
         }
-      return node_of_lattice(lattice);
+      return node(idx);
     }
 
-    // Local node index of lattice node (i,j,k), or -1 outside the lattice.
+    // Local node index of lattice node (i,j,k), or -1 outside the lattice or absent.
     MPM_HOST_DEVICE int node(const int idx[dim]) const
     {
+      if (lattice_to_node == nullptr)
+        return node_in_box(idx);
       long lattice = 0;
       for (int d = dim - 1; d >= 0; --d)
         {
@@ -106,17 +110,54 @@ namespace mpm
             return -1;
           lattice = lattice * (n_cells[d] + 1) + idx[d];
         }
-      return node_of_lattice(lattice);
+      return lattice_to_node[lattice];
     }
 
-    // Local node index of a lattice index inside the lattice.
-    MPM_HOST_DEVICE int node_of_lattice(const long lattice) const
+    // Without a lookup: the box's node (i,j,k), -1 outside the box (the box lies inside the
+    // lattice, so this covers the lattice's ends too).
+    MPM_HOST_DEVICE int node_in_box(const int idx[dim]) const
+    {
+      long node = 0;
+      for (int d = dim - 1; d >= 0; --d)
+        {
+          // One compare for both ends (a negative difference wraps to a large one).
+          const unsigned int i = static_cast<unsigned int>(idx[d] - box_lower[d]);
+          if (i >= static_cast<unsigned int>(box_nodes[d]))
+            return -1;
+          node = node * box_nodes[d] + i;
+        }
+      return static_cast<int>(node);
+    }
+
+    // Local node index of a lattice index inside the lattice (-1: absent).
+    MPM_HOST_DEVICE int node_of_lattice(long lattice) const
     {
       if (lattice_to_node != nullptr)
         return lattice_to_node[lattice];
-      // One compare for both ends of the slab (a negative difference wraps to a large one).
-      const unsigned long node = static_cast<unsigned long>(lattice - node_offset);
-      return node < static_cast<unsigned long>(n_nodes) ? static_cast<int>(node) : -1;
+      int idx[dim];
+      for (int d = 0; d < dim; ++d)
+        {
+          idx[d] = static_cast<int>(lattice % (n_cells[d] + 1));
+          lattice /= n_cells[d] + 1;
+        }
+      return node_in_box(idx);
+    }
+
+    // The node at an index computed by stencil_base (interpolation.h): the lattice index
+    // through the lookup, or the box's node index itself.
+    MPM_HOST_DEVICE int node_at(const long index) const
+    {
+      return lattice_to_node != nullptr ? lattice_to_node[index] : static_cast<int>(index);
+    }
+
+    // Without a lookup, the box of the whole lattice.
+    MPM_HOST_DEVICE void box_is_lattice()
+    {
+      for (int d = 0; d < dim; ++d)
+        {
+          box_lower[d] = 0;
+          box_nodes[d] = n_cells[d] + 1;
+        }
     }
   };
 

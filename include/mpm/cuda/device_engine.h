@@ -128,13 +128,17 @@ namespace mpm
       int n_points() const;
 
       // One rank, Grid/Nodes = near material (core/active_nodes.h): the device keeps only the
-      // nodes of blocks of block_cells^dim cells near its points as they are now, numbered in
-      // lattice order through a lookup, their masks taken from the whole lattice's (lattice
-      // node order; friction_faces empty where no face is frictional), and the pressure
-      // averaging's cell sums at each cell's lowest node. Every point's home cell becomes its
-      // current cell. A pending averaging is applied first. Returns the number of nodes kept.
+      // nodes of blocks of block_cells^dim cells near its points as they are now: the box
+      // around those blocks, numbered with no lookup, where it is compact enough
+      // (box_of_kept_blocks), else just those blocks' nodes, numbered in lattice order through
+      // a lookup. Their masks come from the whole lattice's (lattice node order;
+      // friction_faces empty where no face is frictional), the pressure averaging's cell sums
+      // sit at each cell's lowest node. Every point's home cell becomes its current cell. A
+      // pending averaging is applied first. Returns the number of nodes kept.
       int keep_nodes_near_points(int block_cells, const std::vector<std::uint8_t> &fixed_components,
                                  const std::vector<std::uint8_t> &friction_faces);
+      // Whether the nodes kept last are a box with no lookup.
+      bool kept_nodes_are_box() const;
       // The nodes kept that way: nodal mass and velocity into `nodes` (geometry and lookup
       // set too) and the lattice index of each node.
       void download_kept_nodes(HostGrid<dim, double> &nodes, std::vector<long> &lattice_of_node) const;

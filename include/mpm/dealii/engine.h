@@ -87,6 +87,10 @@ namespace mpm
     // Nodes the engine updates now, and the most it has had (nodes near the material).
     long n_active_nodes() const { return near_material.now; }
     long most_nodes() const { return near_material.most; }
+    // Of the choices of nodes near the material so far, those and how many were numbered as
+    // the box around the material with no lookup (the GPU's; the CPU always looks up).
+    long node_choices() const { return near_material.choices; }
+    long node_choices_as_box() const { return near_material.as_box; }
     // Replaces the material table (e.g. when plasticity is switched on).
     virtual void set_materials(const std::vector<MaterialParameters<double>> &materials) = 0;
 
@@ -98,11 +102,17 @@ namespace mpm
       ShapeFunction             shape       = ShapeFunction::gimp;
       std::vector<std::uint8_t> lattice_fixed_components, lattice_friction_faces; // of the whole lattice
       long                      now = 0, most = 0;                                 // nodes kept
+      long choices = 0, as_box = 0; // choices that kept nodes, and those numbered as a box (GPU)
 
-      void kept(const long n)
+      void kept(const long n, const bool box = false)
       {
         now  = n;
         most = n > most ? n : most;
+        if (n > 0) // not the choice before any point is loaded
+          {
+            ++choices;
+            as_box += box ? 1 : 0;
+          }
       }
     };
     NearMaterialNodes near_material;

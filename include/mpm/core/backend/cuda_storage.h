@@ -176,12 +176,17 @@ namespace mpm
           force[d].upload(g.force[d]);
           velocity[d].upload(g.velocity[d]);
         }
-      // No lookup where the host's is the identity, or where it has none (a slab of the
-      // lattice starting at node_offset, which the owner sets).
+      // No lookup where the host's is the identity, or where it has none (a box of the
+      // lattice, which the owner sets with set_box; the whole lattice until then).
       lattice_order = g.lattice_to_node.empty() || g.lattice_to_node.size() == g.mass.size();
       for (size_t l = 0; !g.lattice_to_node.empty() && lattice_order && l < g.lattice_to_node.size(); ++l)
         lattice_order = g.lattice_to_node[l] == static_cast<int>(l);
       lattice_to_node.upload(lattice_order ? std::vector<int>() : g.lattice_to_node);
+      for (int d = 0; d < dim; ++d)
+        {
+          box_lower[d] = 0;
+          box_nodes[d] = n_cells[d] + 1;
+        }
       mass.upload(g.mass);
       fixed_components.upload(g.fixed_components);
       friction_faces.upload(g.friction_faces);
@@ -195,7 +200,40 @@ namespace mpm
     void set_nodes(const std::vector<int> &lookup, const std::vector<std::uint8_t> &fixed,
                    const std::vector<std::uint8_t> &friction)
     {
-      const size_t n = fixed.size();
+      reset_nodes(fixed.size());
+      lattice_order = false;
+      lattice_to_node.upload(lookup);
+      fixed_components.upload(fixed);
+      friction_faces.upload(friction);
+    }
+
+    // New nodes: the box of lattice nodes lower[d] .. lower[d] + nodes[d] - 1, in lattice
+    // order with no lookup, with those masks (one per box node; friction empty: no
+    // frictional face) and every nodal value zero.
+    void set_box(const int lower[dim], const int nodes[dim], const std::vector<std::uint8_t> &fixed,
+                 const std::vector<std::uint8_t> &friction)
+    {
+      reset_nodes(fixed.size());
+      set_box(lower, nodes);
+      lattice_to_node.resize(0);
+      fixed_components.upload(fixed);
+      friction_faces.upload(friction);
+    }
+
+    // The numbering only: the nodes are that box of the lattice (the arrays the owner's).
+    void set_box(const int lower[dim], const int nodes[dim])
+    {
+      lattice_order = true;
+      for (int d = 0; d < dim; ++d)
+        {
+          box_lower[d] = lower[d];
+          box_nodes[d] = nodes[d];
+        }
+    }
+
+    // n nodes, every nodal value zero.
+    void reset_nodes(const size_t n)
+    {
       mass.resize(n);
       for (int d = 0; d < dim; ++d)
         {
@@ -207,11 +245,6 @@ namespace mpm
           velocity[d].fill_bytes(0);
         }
       mass.fill_bytes(0);
-      lattice_order = false;
-      node_offset   = 0;
-      lattice_to_node.upload(lookup);
-      fixed_components.upload(fixed);
-      friction_faces.upload(friction);
     }
 
     // Nodal values back to the host (tests, output).
@@ -226,10 +259,11 @@ namespace mpm
       mass.download(g.mass);
     }
 
-    // Whether the nodes are a slab of the lattice in lattice order, from lattice index
-    // node_offset on (the view then has no lookup).
+    // Whether the nodes are a box of the lattice in lattice order (the view then has no
+    // lookup), and that box.
     bool lattice_order = false;
-    long node_offset   = 0;
+    int  box_lower[dim] = {};
+    int  box_nodes[dim] = {};
 
     GridView<dim, Real> view()
     {
@@ -237,7 +271,11 @@ namespace mpm
       if (lattice_order)
         {
           v.lattice_to_node = nullptr;
-          v.node_offset     = node_offset;
+          for (int d = 0; d < dim; ++d)
+            {
+              v.box_lower[d] = box_lower[d];
+              v.box_nodes[d] = box_nodes[d];
+            }
         }
       return v;
     }
