@@ -50,13 +50,12 @@ namespace
           lo[d] = 1 << 20, hi[d] = -1;
         for (const long l : nodes.lattice_of_node)
           {
-            long rest = l;
+            int idx[dim];
+            lattice_node_coordinates<dim>(n_cells, l, idx);
             for (int d = 0; d < dim; ++d)
               {
-                const long i = rest % (n_cells[d] + 1);
-                rest /= n_cells[d] + 1;
-                lo[d] = std::min(lo[d], i);
-                hi[d] = std::max(hi[d], i);
+                lo[d] = std::min(lo[d], long(idx[d]));
+                hi[d] = std::max(hi[d], long(idx[d]));
               }
           }
         bool same = true;

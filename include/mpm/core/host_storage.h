@@ -234,13 +234,9 @@ namespace mpm
     }
 
     // Lattice coordinates of a lattice index (inverse of GridView::node's ordering).
-    void lattice_coordinates(long lattice, int idx[dim]) const
+    void lattice_coordinates(const long lattice, int idx[dim]) const
     {
-      for (int d = 0; d < dim; ++d)
-        {
-          idx[d] = static_cast<int>(lattice % (n_cells[d] + 1));
-          lattice /= n_cells[d] + 1;
-        }
+      lattice_node_coordinates<dim>(n_cells, lattice, idx);
     }
 
     GridView<dim, Real> view() { return make_grid_view<dim, Real>(*this); }

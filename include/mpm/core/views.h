@@ -28,6 +28,17 @@ namespace mpm
     return cell;
   }
 
+  // Coordinates (i,j,k) of lattice node `lattice` (i + (n_x + 1) (j + (n_y + 1) k)).
+  template <int dim>
+  MPM_HOST_DEVICE inline void lattice_node_coordinates(const int n_cells[dim], long lattice, int idx[dim])
+  {
+    for (int d = 0; d < dim; ++d)
+      {
+        idx[d] = static_cast<int>(lattice % (n_cells[d] + 1));
+        lattice /= n_cells[d] + 1;
+      }
+  }
+
   // Uniform background lattice. Its nodes are numbered in one of two ways: through a
   // lookup (deal.II's locally relevant DoF space, the nodes near the material), or, with
   // no lookup, as a box of the lattice in lattice order (device grids: the whole lattice,
@@ -130,16 +141,12 @@ namespace mpm
     }
 
     // Local node index of a lattice index inside the lattice (-1: absent).
-    MPM_HOST_DEVICE int node_of_lattice(long lattice) const
+    MPM_HOST_DEVICE int node_of_lattice(const long lattice) const
     {
       if (lattice_to_node != nullptr)
         return lattice_to_node[lattice];
       int idx[dim];
-      for (int d = 0; d < dim; ++d)
-        {
-          idx[d] = static_cast<int>(lattice % (n_cells[d] + 1));
-          lattice /= n_cells[d] + 1;
-        }
+      lattice_node_coordinates<dim>(n_cells, lattice, idx);
       return node_in_box(idx);
     }
 
