@@ -36,7 +36,7 @@ run() {
   kill $smi 2>/dev/null
   wait $smi 2>/dev/null
   echo "== $name (np $np, rc $rc)"
-  grep -E "done, t =|of steps and output|CUDA device of rank|per-launch|GPU ghost exchange|loop on rank" "$out/$name.log" | cut -c1-400
+  grep -E "done, t =|of steps and output|CUDA device of rank|per-launch|GPU ghost exchange|exchange overlap|loop on rank" "$out/$name.log" | cut -c1-400
   grep -E "\| (MPM step|migrate points|repartition) |built on a thread" "$out/$name.log"
   awk -F', ' '{ if ($3 > mem[$1]) mem[$1] = $3; if ($2 > util[$1]) util[$1] = $2 }
               END { for (g in mem) printf "  GPU %s: at most %s MiB, %s%% busy\n", g, mem[g], util[g] }' "$out/$name.smi"

@@ -37,7 +37,7 @@ for np in $([ "${SKIP_P2:-0}" = 1 ] || echo 1 2); do
   rc=$?
   t1=$(date +%s.%N)
   echo "P2 np $np: rc $rc, $(awk "BEGIN{print $t1 - $t0}") s wall (shell clock) | $(grep -E 'done, t =' "$d.log")"
-  grep -E "CUDA device of rank|ghost-node exchange|GPU ghost exchange|re-sorts|repartition|set-up|loop on rank" "$d.log" | head -11
+  grep -E "CUDA device of rank|ghost-node exchange|GPU ghost exchange|exchange overlap|re-sorts|repartition|set-up|loop on rank" "$d.log" | head -12
   grep -A16 "Total wallclock" "$d.log" | grep -E "MPM step|migrate|repartition|output|history|setup|Total" | head -12
 done
 

@@ -231,6 +231,11 @@ namespace mpm
         return shared_grid == nullptr ? -1 : exchange_seconds_before + device->exchange_seconds();
       }
 
+      double share_of_points_before_overlap() override
+      {
+        return shared_grid == nullptr ? -1 : device->share_of_points_before_overlap();
+      }
+
       double exchange_host_seconds() override
       {
         return shared_grid == nullptr ? -1 : exchange_host_seconds_before + exchange->host_seconds();
@@ -496,7 +501,10 @@ namespace mpm
                   << (mpi_is_cuda_aware() ? "the MPI is CUDA-aware, but device buffers are not passed to it yet" :
                                             "the MPI is not CUDA-aware")
                   << "): " << *std::max_element(bytes.begin(), bytes.end())
-                  << " bytes per array each way on the busiest rank, at the start" << std::endl;
+                  << " bytes per array each way on the busiest rank, at the start; "
+                  << (cuda::exchange_overlap_enabled() ? "overlapped with the passes of the points that cannot reach it" :
+                                          "not overlapped (MPM_CUDA_OVERLAP=0)")
+                  << std::endl;
       }
     return std::make_unique<CudaEngine<dim>>(grid, materials, shape);
 #else

@@ -506,9 +506,15 @@ namespace mpm
         const double host_part = max(s.engine->exchange_host_seconds(), s.communicator);
         if (exchange >= 0 && steps > 0)
           s.pcout << "  GPU ghost exchange: " << exchange << " s on the slowest rank, " << 1e3 * exchange / steps
-                  << " ms per step (device time from the end of each P2G to the sums in place: the copies, the "
-                     "host's part and MPI), of which the host's part "
+                  << " ms per step (device time from the end of the work before each exchange to the sums in place: "
+                     "the copies, the host's part and MPI; where it overlaps, other points' passes run meanwhile), "
+                     "of which the host's part "
                   << 1e3 * host_part / steps << " ms per step (copies into the partitioner's layout and MPI)\n";
+        const double first_share = max(s.engine->share_of_points_before_overlap(), s.communicator);
+        if (exchange >= 0 && steps > 0 && first_share >= 0)
+          s.pcout << "  GPU exchange overlap: the passes of at most " << 100 * first_share
+                  << "% of a rank's points (mean over the sorts) run before each exchange, the others' while it "
+                     "travels\n";
       }
     if (steps > 0)
       {

@@ -5,6 +5,7 @@
 #include <mpm/core/backend/cuda_point_order.h>
 #include <mpm/core/backend/cuda_storage.h>
 #include <mpm/core/active_nodes.h>
+#include <mpm/core/exchange_overlap.h>
 #include <mpm/core/migration.h>
 #include <mpm/cuda/device_engine.h>
 
@@ -67,6 +68,12 @@ namespace mpm
       return device;
     }
 
+    bool exchange_overlap_enabled()
+    {
+      const char *overlap = std::getenv("MPM_CUDA_OVERLAP");
+      return overlap == nullptr || overlap[0] != '0';
+    }
+
     namespace
     {
       // Pack and unpack of the exchanged entries, entry by entry (the host's MPI buffers'
@@ -113,10 +120,21 @@ namespace mpm
         int         current    = 0;
         double      seconds    = 0;
 
+        // The overlapped form (begin, end): pack, copies and unpack on a stream of their own
+        // (the highest priority, so that its small launches get the first free multiprocessors
+        // beside the pass that runs meanwhile); `copied`: the packed values are on the host.
+        cudaStream_t side   = nullptr;
+        cudaEvent_t  copied = nullptr;
+
         Staging()                = default;
         Staging(const Staging &) = delete;
         ~Staging()
         {
+          if (side != nullptr)
+            {
+              cudaEventDestroy(copied);
+              cudaStreamDestroy(side);
+            }
           cudaFreeHost(host);
           for (int k = 0; k < 2; ++k)
             if (begin[k] != nullptr)
@@ -148,15 +166,12 @@ namespace mpm
 
         void set_index(const std::vector<Index> &i) { index.upload(i); }
 
-        // Packs count arrays, hands the host copy to sum (which replaces it by the sums over
-        // the ranks), unpacks; in the stream's order, the host waits for the pack only.
-        template <typename Sum>
-        void exchange(CudaBackend &backend, double *const *arrays, const int count, Sum &&sum)
+        // Buffers for count arrays, the events, and the arrays' list.
+        ArrayList prepare(double *const *arrays, const int count)
         {
           if (count > max_exchanged_arrays)
             throw std::logic_error("DeviceEngine: too many arrays in one exchange");
-          const long n     = static_cast<long>(index.size());
-          const long total = n * count;
+          const long total = static_cast<long>(index.size()) * count;
           ArrayList  list{};
           for (int k = 0; k < count; ++k)
             list.array[k] = arrays[k];
@@ -169,15 +184,80 @@ namespace mpm
               MPM_CUDA_CHECK(cudaMallocHost(&host, total * sizeof(double)));
               host_n = total;
             }
-          const cudaStream_t stream  = backend.get_stream();
-          const int          threads = 256;
-          const long         blocks  = (total + threads - 1) / threads;
           if (begin[0] == nullptr)
             for (int k = 0; k < 2; ++k)
               {
                 MPM_CUDA_CHECK(cudaEventCreate(&begin[k]));
                 MPM_CUDA_CHECK(cudaEventCreate(&end[k]));
               }
+          return list;
+        }
+
+        // The overlapped exchange, first half: after the work queued so far on the backend's
+        // stream, packs the arrays and copies them to the host on the side stream; returns at
+        // once. The work queued next on the backend's stream must not touch an exchanged entry.
+        void begin_overlapped(CudaBackend &backend, double *const *arrays, const int count)
+        {
+          list_in_flight = prepare(arrays, count);
+          count_in_flight = count;
+          if (side == nullptr)
+            {
+              int least = 0, greatest = 0;
+              MPM_CUDA_CHECK(cudaDeviceGetStreamPriorityRange(&least, &greatest));
+              MPM_CUDA_CHECK(cudaStreamCreateWithPriority(&side, cudaStreamNonBlocking, greatest));
+              MPM_CUDA_CHECK(cudaEventCreateWithFlags(&copied, cudaEventDisableTiming));
+            }
+          const long total = static_cast<long>(index.size()) * count;
+          MPM_CUDA_CHECK(cudaEventRecord(begin[current], backend.get_stream()));
+          MPM_CUDA_CHECK(cudaStreamWaitEvent(side, begin[current], 0));
+          if (total > 0)
+            {
+              pack_kernel<Index><<<(total + 255) / 256, 256, 0, side>>>(static_cast<long>(index.size()), count,
+                                                                       index.data(), list_in_flight, packed.data());
+              MPM_CUDA_CHECK_LAUNCH();
+              MPM_CUDA_CHECK(cudaMemcpyAsync(host, packed.data(), total * sizeof(double), cudaMemcpyDeviceToHost, side));
+            }
+          MPM_CUDA_CHECK(cudaEventRecord(copied, side));
+        }
+
+        // Second half: waits for the copy, hands it to sum (collective over the ranks), unpacks
+        // the sums on the side stream; the backend's stream waits for them before its next work.
+        template <typename Sum>
+        void end_overlapped(CudaBackend &backend, Sum &&sum)
+        {
+          const long total = static_cast<long>(index.size()) * count_in_flight;
+          MPM_CUDA_CHECK(cudaEventSynchronize(copied));
+          if (pending[1 - current])
+            add(1 - current);
+          sum(host, count_in_flight);
+          if (total > 0)
+            {
+              MPM_CUDA_CHECK(cudaMemcpyAsync(packed.data(), host, total * sizeof(double), cudaMemcpyHostToDevice, side));
+              unpack_kernel<Index><<<(total + 255) / 256, 256, 0, side>>>(static_cast<long>(index.size()),
+                                                                         count_in_flight, index.data(), packed.data(),
+                                                                         list_in_flight);
+              MPM_CUDA_CHECK_LAUNCH();
+            }
+          MPM_CUDA_CHECK(cudaEventRecord(end[current], side));
+          MPM_CUDA_CHECK(cudaStreamWaitEvent(backend.get_stream(), end[current], 0));
+          pending[current] = true;
+          current          = 1 - current;
+        }
+
+        ArrayList list_in_flight{};
+        int       count_in_flight = 0;
+
+        // Packs count arrays, hands the host copy to sum (which replaces it by the sums over
+        // the ranks), unpacks; in the stream's order, the host waits for the pack only.
+        template <typename Sum>
+        void exchange(CudaBackend &backend, double *const *arrays, const int count, Sum &&sum)
+        {
+          const ArrayList    list    = prepare(arrays, count);
+          const long         n       = static_cast<long>(index.size());
+          const long         total   = n * count;
+          const cudaStream_t stream  = backend.get_stream();
+          const int          threads = 256;
+          const long         blocks  = (total + threads - 1) / threads;
           MPM_CUDA_CHECK(cudaEventRecord(begin[current], stream));
           if (total > 0)
             {
@@ -329,6 +409,28 @@ namespace mpm
             cells->exchange(*backend, arrays, count,
                             [this](double *values, const int c) { exchange->sum_cells(values, c); });
         }
+
+        // The overlap (explicit_step's pass_then_sum): the points in the device's order whose
+        // home cells reach an exchanged entry come first, first_points of them (-1: not known
+        // for the current order and home cells, or overlap off).
+        int  first_points = -1;
+        int  points_before_overlap() const { return exchange != nullptr ? first_points : -1; }
+        template <typename Real>
+        void begin_sum(const ExchangedEntries entries, Real *const *arrays, const int count) const
+        {
+          static_assert(std::is_same<Real, double>::value, "the engine runs in double");
+          if (entries == ExchangedEntries::nodes)
+            nodes->begin_overlapped(*backend, arrays, count);
+          else
+            cells->begin_overlapped(*backend, arrays, count);
+        }
+        void end_sum(const ExchangedEntries entries) const
+        {
+          if (entries == ExchangedEntries::nodes)
+            nodes->end_overlapped(*backend, [this](double *values, const int c) { exchange->sum_nodal(values, c); });
+          else
+            cells->end_overlapped(*backend, [this](double *values, const int c) { exchange->sum_cells(values, c); });
+        }
       };
 
       // Cell arrays of the pressure averaging, where this version of GridView has them.
@@ -378,6 +480,13 @@ namespace mpm
       bool                         home_by_slot_stale = true;
       std::vector<DeviceArray<double>> labels; // several ranks: ids, initial positions; in upload order
       DeviceArray<std::uint8_t>    owned_cells; // several ranks: 1 for each lattice cell this rank owns
+      // Several ranks: 1 for each lattice cell whose points can add into an exchanged entry
+      // (exchange_overlap.h); those points come first in each sort, and the passes before an
+      // exchange overlap it (explicit_step). Empty where the exchange is not overlapped
+      // (MPM_CUDA_OVERLAP=0). The share of points that came first, summed over the sorts.
+      DeviceArray<std::uint8_t>    cells_before_overlap;
+      double                       first_share_sum = 0;
+      long                         n_split_sorts   = 0;
       // The re-sort's (take_leaving_points) flags, slot lists and gathers' scratch: kept
       // between re-sorts.
       ResortScratch                resort;
@@ -526,6 +635,14 @@ namespace mpm
             }
           impl->exchanged_nodes.set_index(slab_nodes);
           impl->exchanged_cells.set_index(exchange->exchanged_cells());
+          if (exchange_overlap_enabled())
+            {
+              std::vector<long> lattice_nodes_exchanged(slab_nodes.size());
+              for (std::size_t j = 0; j < slab_nodes.size(); ++j)
+                lattice_nodes_exchanged[j] = slab_nodes[j] + node_offset;
+              impl->cells_before_overlap.upload(
+                cells_reaching_exchange<dim>(g.n_cells, lattice_nodes_exchanged, exchange->exchanged_cells()));
+            }
         }
     }
 
@@ -541,6 +658,7 @@ namespace mpm
       impl->home_by_slot_stale = true;
       impl->labels.clear();       // upload_labels gives those of these points
       impl->steps_since_upload = 0;
+      impl->exchange.first_points = -1; // until the next sort, by these points' home cells
       impl->averaging_pending  = false; // the host's stresses are final
     }
 
@@ -593,15 +711,27 @@ namespace mpm
       GridView<dim, double> g = impl->grid.view();
       if (sort_interval > 0 && impl->steps_since_upload % sort_interval == 0)
         {
+          // The overlap's split needs every point's home cell.
+          const bool split = impl->cells_before_overlap.size() > 0 &&
+                             static_cast<int>(impl->home_cells.size()) == impl->points.size();
+          const long         *home  = split ? impl->home_cells.data() : nullptr;
+          const std::uint8_t *cells = split ? impl->cells_before_overlap.data() : nullptr;
+          int                 first = -1;
           if (impl->shape == ShapeFunction::gimp)
-            impl->order.template sort<GimpShape>(impl->backend, g, impl->points);
+            first = impl->order.template sort<GimpShape>(impl->backend, g, impl->points, home, cells);
           else if (impl->shape == ShapeFunction::bspline2)
-            impl->order.template sort<QuadraticBSplineShape>(impl->backend, g, impl->points);
+            first = impl->order.template sort<QuadraticBSplineShape>(impl->backend, g, impl->points, home, cells);
           else if (impl->shape == ShapeFunction::bspline3)
-            impl->order.template sort<CubicBSplineShape>(impl->backend, g, impl->points);
+            first = impl->order.template sort<CubicBSplineShape>(impl->backend, g, impl->points, home, cells);
           else
-            impl->order.template sort<LinearShape>(impl->backend, g, impl->points);
-          impl->home_by_slot_stale = true;
+            first = impl->order.template sort<LinearShape>(impl->backend, g, impl->points, home, cells);
+          impl->home_by_slot_stale    = true;
+          impl->exchange.first_points = first;
+          if (first >= 0 && impl->points.size() > 0)
+            {
+              impl->first_share_sum += static_cast<double>(first) / impl->points.size();
+              ++impl->n_split_sorts;
+            }
         }
       ++impl->steps_since_upload;
       if (s.pressure_averaging)
@@ -692,7 +822,8 @@ namespace mpm
       if (static_cast<int>(home_cells.size()) != impl->points.size())
         throw std::invalid_argument("DeviceEngine::set_home_cells: one home cell per uploaded point is needed");
       impl->home_cells.upload(home_cells);
-      impl->home_by_slot_stale = true;
+      impl->home_by_slot_stale    = true;
+      impl->exchange.first_points = -1; // the split follows the home cells at the next sort
     }
 
     template <int dim>
@@ -834,6 +965,7 @@ namespace mpm
       take_slots<dim>(impl->points, r.leaving_slots, leaving, impl->slot_scratch, stream);
       keep_slots<dim>(impl->points, r.kept_slots, impl->slot_scratch, stream);
       impl->home_cells.resize(0); // append_points sets them
+      impl->exchange.first_points = -1;
       return n_dropped;
     }
 
@@ -890,6 +1022,12 @@ namespace mpm
     double DeviceEngine<dim>::exchange_seconds()
     {
       return impl->exchanged_nodes.exchange_seconds() + impl->exchanged_cells.exchange_seconds();
+    }
+
+    template <int dim>
+    double DeviceEngine<dim>::share_of_points_before_overlap() const
+    {
+      return impl->n_split_sorts > 0 ? impl->first_share_sum / impl->n_split_sorts : -1;
     }
 
     template <int dim>

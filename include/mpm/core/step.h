@@ -133,6 +133,25 @@ namespace mpm
     {}
   };
 
+  // Exchanges that overlap the sums with work (the device's on several ranks) also have
+  //   int  points_before_overlap() : how many leading points can add into exchanged entries
+  //                                  (exchange_overlap.h), -1 where they do not overlap now;
+  //   void begin_sum(ExchangedEntries, arrays, count) : starts the sum of what the work so far
+  //                                  added (the leading points' pass);
+  //   void end_sum(ExchangedEntries) : the sums are in the arrays for the work after it.
+  enum class ExchangedEntries
+  {
+    nodes,
+    cells
+  };
+  template <typename Exchange, typename = void>
+  struct overlaps_exchange : std::false_type
+  {};
+  template <typename Exchange>
+  struct overlaps_exchange<Exchange, std::void_t<decltype(std::declval<const Exchange &>().points_before_overlap())>>
+    : std::true_type
+  {};
+
   // Backends whose scatters run in parallel by colouring (CpuBackend) declare
   // `static constexpr bool colours_scatter = true` and group the points first.
   template <typename Backend, typename = void>
@@ -971,6 +990,28 @@ namespace mpm
       });
     }
 
+    // pass(points) over every point, then the sum of the arrays over the ranks. Where the
+    // exchange overlaps (n_first >= 0), the first n_first points (those that can add into
+    // exchanged entries) go first, the sum starts, and the other points' pass runs while the
+    // sums travel: they add into no exchanged entry, so the sums and the step are the same.
+    template <typename Exchange, int dim, typename Real, typename Pass, typename Sum>
+    void pass_then_sum(const Exchange &exchange, const int n_first, const PointsView<dim, Real> &p, Pass &&pass,
+                       const ExchangedEntries entries, Real *const *arrays, const int count, Sum &&sum)
+    {
+      (void)n_first;
+      if constexpr (overlaps_exchange<Exchange>::value)
+        if (n_first >= 0 && n_first <= p.n_points)
+          {
+            pass(point_range(p, 0, n_first));
+            exchange.begin_sum(entries, arrays, count);
+            pass(point_range(p, n_first, p.n_points - n_first));
+            exchange.end_sum(entries);
+            return;
+          }
+      pass(p);
+      sum();
+    }
+
     // exchange.sum_cells if the exchange has one; exchanges for one rank only (the CUDA
     // engine's nodal adapter) may have none.
     template <typename Exchange, typename Real>
@@ -1159,12 +1200,34 @@ namespace mpm
     };
     // Atomic backends add the affine transfers' momentum in a pass of its own, after each P2G of
     // the momentum (add_affine_momentum).
-    auto affine_momentum = [&]() {
+    auto affine_momentum = [&](const PointsView<dim, Real> &q) {
       if constexpr (atomic_scatter<Backend>::value && physics == DevicePhysics::all)
         if (s.affine_state_variable >= 0)
-          add_affine_momentum<dim, Shape>(backend, g, p, s);
+          add_affine_momentum<dim, Shape>(backend, g, q, s);
     };
     group_for_scatter<dim, Shape>(backend, g, p, s);
+    // MUSL and USL: the passes before an exchange (P2G, the remap, the kinematics with the
+    // averaging's cell sums) overlap it where the exchange can (pass_then_sum). Only where
+    // the scatter is atomic: host backends keep each point's stencil, and its colour, by the
+    // point's index, so their passes are never split.
+    int n_first = -1;
+    if constexpr (overlaps_exchange<Exchange>::value && atomic_scatter<Backend>::value)
+      n_first = exchange.points_before_overlap();
+    auto sum_nodal = [&](Real *const *arrays, const int count) {
+      return [&exchange, arrays, count]() { exchange.sum_nodal(arrays, count); };
+    };
+    Real *cell_sums[2] = {g.cell_volume, g.cell_pressure_volume};
+    // The kinematics pass, then the averaging's cell sums where it scattered them.
+    auto kinematics_then_cell_sums = [&](auto &&kinematics) {
+      if (scatter_in_kinematics)
+        pass_then_sum(exchange, n_first, p, kinematics, ExchangedEntries::cells, cell_sums, 2,
+                      [&]() { sum_cells(exchange, cell_sums, 2, 0); });
+      else
+        {
+          kinematics(p);
+          scatter_averaged_pressure();
+        }
+    };
     switch (s.scheme)
       {
         case UpdateScheme::musl:
@@ -1177,37 +1240,51 @@ namespace mpm
               stencils = backend.point_scratch(p.n_points, sizeof(HostStencil<dim, Shape, Real>));
 #endif
             reset_grid(backend, g, true, s.pressure_averaging && !apply_pending);
-            particles_to_grid<dim, Shape, physics>(backend, g, p, s, true, true, stencils, apply_pending);
-            affine_momentum();
-            exchange.sum_nodal(p2g_sums, 2 * dim + 1);
+            pass_then_sum(
+              exchange, n_first, p,
+              [&](const PointsView<dim, Real> &q) {
+                particles_to_grid<dim, Shape, physics>(backend, g, q, s, true, true, stencils, apply_pending);
+                affine_momentum(q);
+              },
+              ExchangedEntries::nodes, p2g_sums, 2 * dim + 1, sum_nodal(p2g_sums, 2 * dim + 1));
             update_grid(backend, g, s, dt, true, apply_pending);
-            grid_to_particle_velocity_and_remap<dim, Shape, physics>(backend, g, p, s, stencils);
-            affine_momentum();
-            exchange.sum_nodal(momentum, dim);
+            pass_then_sum(
+              exchange, n_first, p,
+              [&](const PointsView<dim, Real> &q) {
+                grid_to_particle_velocity_and_remap<dim, Shape, physics>(backend, g, q, s, stencils);
+                affine_momentum(q);
+              },
+              ExchangedEntries::nodes, momentum, dim, sum_nodal(momentum, dim));
             if (!s.hold_points || s.hold_from_point_momentum) // held, the grid keeps its updated ones
               velocity_from_momentum(backend, g, s.mass_tolerance);
-            grid_to_particle_kinematics<dim, Shape, physics>(backend, g, p, materials, s, dt, true, true, stencils,
-                                                    scatter_in_kinematics);
+            kinematics_then_cell_sums([&](const PointsView<dim, Real> &q) {
+              grid_to_particle_kinematics<dim, Shape, physics>(backend, g, q, materials, s, dt, true, true, stencils,
+                                                               scatter_in_kinematics);
+            });
           }
-          scatter_averaged_pressure();
           break;
 
         case UpdateScheme::usl:
           reset_grid(backend, g, true, s.pressure_averaging && !apply_pending);
-          particles_to_grid<dim, Shape, physics>(backend, g, p, s, true, true, nullptr, apply_pending);
-          affine_momentum();
-          exchange.sum_nodal(p2g_sums, 2 * dim + 1);
+          pass_then_sum(
+            exchange, n_first, p,
+            [&](const PointsView<dim, Real> &q) {
+              particles_to_grid<dim, Shape, physics>(backend, g, q, s, true, true, nullptr, apply_pending);
+              affine_momentum(q);
+            },
+            ExchangedEntries::nodes, p2g_sums, 2 * dim + 1, sum_nodal(p2g_sums, 2 * dim + 1));
           update_grid(backend, g, s, dt, false, apply_pending);
           grid_to_particle_velocity<dim, Shape, physics>(backend, g, p, s);
-          grid_to_particle_kinematics<dim, Shape, physics>(backend, g, p, materials, s, dt, true, true, nullptr,
-                                                  scatter_in_kinematics);
-          scatter_averaged_pressure();
+          kinematics_then_cell_sums([&](const PointsView<dim, Real> &q) {
+            grid_to_particle_kinematics<dim, Shape, physics>(backend, g, q, materials, s, dt, true, true, nullptr,
+                                                             scatter_in_kinematics);
+          });
           break;
 
         case UpdateScheme::usf:
           reset_grid(backend, g, true);
           particles_to_grid<dim, Shape, physics>(backend, g, p, s, true, false);
-          affine_momentum();
+          affine_momentum(p);
           exchange.sum_nodal(mass_and_momentum, dim + 1);
           if (!s.hold_points || s.hold_from_point_momentum) // held, the last step's grid velocities
             velocity_from_momentum(backend, g, s.mass_tolerance);

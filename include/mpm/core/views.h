@@ -191,4 +191,41 @@ namespace mpm
     Real *state_variables[max_state_variables] = {};
     int   n_state_variables                     = 0;
   };
+
+  // Points first .. first + count - 1 of p, as a view of their own (point 0 is p's point first).
+  template <int dim, typename Real>
+  PointsView<dim, Real> point_range(PointsView<dim, Real> p, const int first, const int count)
+  {
+    p.n_points = count;
+    auto shift = [first](auto *&array) {
+      if (array != nullptr)
+        array += first;
+    };
+    for (int d = 0; d < dim; ++d)
+      {
+        shift(p.position[d]);
+        shift(p.velocity[d]);
+        shift(p.domain_half_length[d]);
+        shift(p.initial_domain_half_length[d]);
+      }
+    for (int c = 0; c < n_voigt; ++c)
+      {
+        shift(p.stress[c]);
+        shift(p.strain[c]);
+      }
+    for (int k = 0; k < dim * dim; ++k)
+      shift(p.deformation_gradient[k]);
+    for (int k = 0; k < p.n_state_variables; ++k)
+      shift(p.state_variables[k]);
+    shift(p.mass);
+    shift(p.volume);
+    shift(p.initial_volume);
+    shift(p.plastic_strain);
+    shift(p.material_field);
+    shift(p.material);
+    static_assert(sizeof(PointsView<dim, Real>) ==
+                    sizeof(void *) * (4 * dim + 2 * n_voigt + dim * dim + 6 + max_state_variables + 2),
+                  "point_range shifts every array of PointsView: shift the one added too");
+    return p;
+  }
 } // namespace mpm

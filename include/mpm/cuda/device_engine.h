@@ -63,6 +63,11 @@ namespace mpm
       virtual void              sum_cells(double *values, int count) = 0;
     };
 
+    // Whether the engines on several ranks overlap the exchange with the passes of the points
+    // that cannot reach it (DeviceEngine::share_of_points_before_overlap): yes unless the
+    // environment sets MPM_CUDA_OVERLAP=0 (for before/after timings in one build).
+    bool exchange_overlap_enabled();
+
     template <int dim>
     class DeviceEngine
     {
@@ -146,6 +151,11 @@ namespace mpm
       // Several ranks: the device time of the ghost exchanges so far, from the end of the
       // work before each to its sums unpacked (the host round trip and MPI included).
       double exchange_seconds();
+      // Several ranks: the passes before each exchange run first over the points that can add
+      // into an exchanged entry, and the others' pass runs while the sums travel (on by default;
+      // MPM_CUDA_OVERLAP=0 turns it off). The mean share of the rank's points that went first,
+      // over the sorts so far (-1: never split).
+      double share_of_points_before_overlap() const;
 
     private:
       struct Impl;

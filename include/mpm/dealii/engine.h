@@ -65,6 +65,9 @@ namespace mpm
     virtual double exchange_seconds() { return -1; }
     // Of those, the seconds the host spent in them (copies and MPI); negative where not measured.
     virtual double exchange_host_seconds() { return -1; }
+    // The GPU engine on several ranks: the mean share of the rank's points whose passes run
+    // before each exchange (the others' run while it travels); negative where none overlap.
+    virtual double share_of_points_before_overlap() { return -1; }
     // Steps between re-sorts of the points (Backend/Sort interval); engines that do not
     // re-sort ignore it.
     virtual void set_sort_interval(int /*steps*/) {}

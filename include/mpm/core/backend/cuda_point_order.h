@@ -73,12 +73,16 @@ namespace mpm
 
     // Sorts the points by the first lattice node of their stencil (removed points last),
     // permuting every point array; the point views taken before are invalid afterwards.
+    // With first_cells (one flag per lattice cell) and home_cells (each point's lattice cell,
+    // in the order of the last reset()), the points whose home cell is flagged come first,
+    // each group sorted by stencil: returns how many (exchange_overlap.h), else -1.
     template <typename Shape>
-    void sort(CudaBackend &backend, const GridView<dim, Real> &g, DevicePoints<dim, Real> &points)
+    int sort(CudaBackend &backend, const GridView<dim, Real> &g, DevicePoints<dim, Real> &points,
+             const long *home_cells = nullptr, const std::uint8_t *first_cells = nullptr)
     {
       const int n = points.size();
       if (n == 0)
-        return;
+        return first_cells != nullptr ? 0 : -1;
       if (static_cast<int>(original.size()) != n)
         reset(backend, n);
       keys.resize(n);
@@ -89,8 +93,15 @@ namespace mpm
       long n_lattice_nodes = 1;
       for (int d = 0; d < dim; ++d)
         n_lattice_nodes *= g.n_cells[d] + 1;
-      const int removed_key = static_cast<int>(n_lattice_nodes);
-      const PointsView<dim, Real> p = points.view();
+      // Keys: stencil node, plus the lattice's node count for the second group.
+      const bool split = home_cells != nullptr && first_cells != nullptr && 2 * n_lattice_nodes < (1L << 30);
+      if (!split)
+        first_cells = nullptr;
+      const long                  second_group = split ? n_lattice_nodes : 0;
+      const long                  n_cells_all  = n_lattice_cells_of(g);
+      const int                   removed_key  = static_cast<int>(n_lattice_nodes + second_group);
+      const int                  *from_slot    = original.data();
+      const PointsView<dim, Real> p            = points.view();
       int *key = keys.data(), *iota = identity.data();
       backend.for_each_node(n, [=] __device__(const int i) {
         iota[i] = i;
@@ -98,6 +109,12 @@ namespace mpm
           {
             key[i] = removed_key;
             return;
+          }
+        long offset = 0;
+        if (first_cells != nullptr)
+          {
+            const long home = home_cells[from_slot[i]];
+            offset          = home >= 0 && home < n_cells_all && first_cells[home] == 0 ? second_group : 0;
           }
         long lattice = 0;
         for (int d = dim - 1; d >= 0; --d)
@@ -112,11 +129,11 @@ namespace mpm
             first   = first < 0 ? 0 : (first > g.n_cells[d] ? g.n_cells[d] : first);
             lattice = lattice * (g.n_cells[d] + 1) + first;
           }
-        key[i] = static_cast<int>(lattice);
+        key[i] = static_cast<int>(lattice + offset);
       });
 
       int end_bit = 1;
-      while ((1L << end_bit) <= n_lattice_nodes)
+      while ((1L << end_bit) <= removed_key)
         ++end_bit;
       size_t temp_bytes = 0;
       MPM_CUDA_CHECK(cub::DeviceRadixSort::SortPairs(nullptr, temp_bytes, keys.data(), sorted_keys.data(),
@@ -133,6 +150,13 @@ namespace mpm
       for_each_point_array<dim>(points, points, [&](auto &array, auto &) { collect(array, reals, ints); });
       permute(backend, reals, real_group_scratch);
       permute(backend, ints, int_group_scratch);
+      if (!split)
+        return -1;
+      const int *sorted = sorted_keys.data();
+      const int  bound  = static_cast<int>(n_lattice_nodes);
+      return backend.reduce_points(
+        n, 0, [=] __device__(const int i) { return sorted[i] < bound ? 1 : 0; },
+        [] __device__(const int a, const int b) { return a + b; });
     }
 
     // Every point array copied to the host in the reference order: put back in that order
@@ -165,6 +189,14 @@ namespace mpm
     const int *original_index() const { return original.data(); }
 
   private:
+    static long n_lattice_cells_of(const GridView<dim, Real> &g)
+    {
+      long n = 1;
+      for (int d = 0; d < dim; ++d)
+        n *= g.n_cells[d];
+      return n;
+    }
+
     DeviceArray<int>  keys, sorted_keys, identity, permutation, original, int_scratch;
     DeviceArray<Real> real_scratch;
     DeviceArray<char> temp;
