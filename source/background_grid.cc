@@ -7,6 +7,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <unordered_map>
 
 namespace mpm
 {
@@ -86,8 +88,16 @@ namespace mpm
     return grid;
   }
 
+  unsigned int cell_partition_weight(const double n_points, const double point_weight)
+  {
+    constexpr double max_weight = std::numeric_limits<int>::max();
+    const double     per_point  = std::min(std::round(16 * point_weight), max_weight);
+    return static_cast<unsigned int>(std::min(16 + per_point * n_points, max_weight));
+  }
+
   template <int dim>
-  BackgroundGrid<dim>::BackgroundGrid(const Parameters &parameters, MPI_Comm communicator)
+  BackgroundGrid<dim>::BackgroundGrid(const Parameters &parameters, MPI_Comm communicator,
+                                      const std::vector<const HostPoints<dim, double> *> &start_points)
     : communicator(communicator)
     , n_ranks(dealii::Utilities::MPI::n_mpi_processes(communicator))
     , triangulation_storage(n_ranks > 1 ? std::make_unique<dealii::parallel::distributed::Triangulation<dim>>(communicator) :
@@ -124,7 +134,34 @@ namespace mpm
       repetitions[d] = n_cells[d] >> levels;
     // colorize: boundary ids 0..2dim-1 for x min, x max, y min, ...; children inherit them.
     dealii::GridGenerator::subdivided_hyper_rectangle(triangulation, repetitions, p1, p2, true);
+    // Several ranks: p4est partitions the refined cells by the start points' work (the
+    // partition after refine_global; Parallel/Load balance threshold 0 leaves it by cells).
+    boost::signals2::scoped_connection weights;
+    std::unordered_map<long, unsigned int> points_in_cell;
+    if (distributed != nullptr && !start_points.empty() && parameters.load_balance_threshold > 0)
+      {
+        for (const HostPoints<dim, double> *points : start_points)
+          for (int i = 0; i < points->size(); ++i)
+            {
+              double x[dim];
+              for (int d = 0; d < dim; ++d)
+                x[d] = points->position[d][i];
+              ++points_in_cell[lattice_cell_of(x)];
+            }
+        const double point_weight = parameters.point_weight;
+        using CellStatus          = typename dealii::Triangulation<dim>::CellStatus;
+        weights                   = triangulation.signals.weight.connect(
+          [&points_in_cell, point_weight, this](const typename dealii::Triangulation<dim>::cell_iterator &cell,
+                                                const CellStatus) -> unsigned int {
+            const dealii::Point<dim> center = cell->center();
+            const auto               found  = points_in_cell.find(lattice_cell_of(&center[0]));
+            return cell_partition_weight(found == points_in_cell.end() ? 0 : found->second, point_weight);
+          });
+      }
     triangulation.refine_global(levels);
+    if (weights.connected() && levels == 0) // no refinement, so no partition after it
+      distributed->repartition();
+    weights.disconnect();
     distribute_nodes();
   }
 

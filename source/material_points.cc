@@ -74,24 +74,16 @@ namespace mpm
     , state_variable_names(parameters.state_variable_names())
     , grid(grid)
   {
-    // Work of a cell for p4est's weighted partition (deal.II's 'weight' signal, no base
-    // weight): an empty cell costs 1 unit (node updates), each point Point weight units.
-    // Integer weights: scaled by 16 so that fractional point weights keep their meaning.
-    // p4est reads each cell's weight as an int: both are capped there (a Point weight of 1e9
-    // wrapped around to a negative weight, and p4est's partition aborted).
-    constexpr double   max_weight   = std::numeric_limits<int>::max();
-    const unsigned int cell_weight  = 16;
-    const unsigned int point_weight =
-      static_cast<unsigned int>(std::min(std::round(16 * parameters.point_weight), max_weight));
-    this->point_weight              = point_weight / 16.;
-    using CellStatus = typename dealii::Triangulation<dim>::CellStatus;
-    weight_connection = grid.triangulation.signals.weight.connect(
-      [this, cell_weight, point_weight, max_weight](const typename dealii::Triangulation<dim>::cell_iterator &cell,
-                                                    const CellStatus status) -> unsigned int {
+    // The cell weights of the load balance: cell_partition_weight (background_grid.h).
+    const double point_weight = parameters.point_weight;
+    this->point_weight        = (cell_partition_weight(1, point_weight) - cell_partition_weight(0, point_weight)) / 16.;
+    using CellStatus          = typename dealii::Triangulation<dim>::CellStatus;
+    weight_connection         = grid.triangulation.signals.weight.connect(
+      [this, point_weight](const typename dealii::Triangulation<dim>::cell_iterator &cell,
+                           const CellStatus status) -> unsigned int {
         // The background grid is never refined or coarsened: only CELL_PERSIST occurs.
         (void)status;
-        return static_cast<unsigned int>(
-          std::min(cell_weight + double(point_weight) * handler.n_particles_in_cell(cell), max_weight));
+        return cell_partition_weight(handler.n_particles_in_cell(cell), point_weight);
       });
   }
 
@@ -550,6 +542,32 @@ namespace mpm
 
   // The inverse of copy_to's property reads: where copy_to reads prop[k] into an array,
   // this writes that array back to values[k]; initial_position comes from the labels.
+  template <int dim>
+  PointSnapshot<dim> PointSnapshot<dim>::selected(const std::function<bool(int)> &keep) const
+  {
+    std::vector<int> kept;
+    for (int i = 0; i < points.size(); ++i)
+      if (keep(i))
+        kept.push_back(i);
+    PointSnapshot<dim> part;
+    part.points.set_n_state_variables(points.n_state_variables());
+    part.points.resize(static_cast<int>(kept.size()));
+    for_each_point_array<dim>(part.points, points, [&](auto &to, const auto &from) {
+      for (std::size_t k = 0; k < kept.size(); ++k)
+        to[k] = from[kept[k]];
+    });
+    auto labels                  = std::make_shared<PointLabels<dim>>();
+    labels->state_variable_names = this->labels->state_variable_names;
+    for (const int i : kept)
+      {
+        labels->id.push_back(this->labels->id[i]);
+        for (int d = 0; d < dim; ++d)
+          labels->initial_position[d].push_back(this->labels->initial_position[d][i]);
+      }
+    part.labels = std::move(labels);
+    return part;
+  }
+
   template <int dim>
   void PointSnapshot<dim>::properties(const int i, double *values) const
   {

@@ -314,7 +314,11 @@ namespace mpm
     else
       {
         s.timer.enter_subsection("setup: grid");
-        s.grid = std::make_unique<BackgroundGrid<dim>>(parameters, s.communicator);
+        // Partitioned by the bodies' points as it is built: no repartition moves them after.
+        std::vector<const HostPoints<dim, double> *> start_points;
+        for (const GeneratedBody<dim> &body : generation.get())
+          start_points.push_back(&body.points);
+        s.grid = std::make_unique<BackgroundGrid<dim>>(parameters, s.communicator, start_points);
         s.timer.leave_subsection();
         s.timer.enter_subsection("setup: material points");
         count_points();

@@ -75,32 +75,34 @@ namespace mpm
     s.output = std::make_unique<OutputWriter<dim>>(parameters, s.communicator, /*resuming=*/true);
     s.output->resume({r.n_outputs, r.grid_records, r.particle_records}, r.step);
 
-    // The grid evenly partitioned; each rank reads every rank's points and keeps those in its
-    // cells (one rank: all, including those that left the grid, as the engine held them).
+    // Each rank reads every rank's points (one rank: all, including those that left the grid,
+    // as the engine held them); on several ranks the grid is partitioned by their work as it is
+    // built, as the grid of a run starting, and each rank keeps the points in its cells.
     const unsigned int rank = dealii::Utilities::MPI::this_mpi_process(s.communicator);
     s.timer.enter_subsection("setup: grid");
+    PointSnapshot<dim> saved =
+      checkpoint::read_points<dim>(folder, r, [&](const HostPoints<dim, double> &p, const int i) {
+        if (!s.parallel || p.material[i] >= 0)
+          return true;
+        if (rank == 0) // left the grid (saved by one rank): dropped here, counted once
+          {
+            ++s.n_dropped;
+            s.dropped_mass += p.mass[i];
+          }
+        return false;
+      });
     if (s.builds_dealii_grid())
       {
-        s.grid   = std::make_unique<BackgroundGrid<dim>>(parameters, s.communicator);
+        s.grid   = std::make_unique<BackgroundGrid<dim>>(parameters, s.communicator,
+                                                       std::vector<const HostPoints<dim, double> *>{&saved.points});
         s.points = std::make_unique<MaterialPoints<dim>>(*s.grid, parameters);
       }
-    const PointSnapshot<dim>   saved =
-      checkpoint::read_points<dim>(folder, r, [&](const HostPoints<dim, double> &p, const int i) {
-        if (!s.parallel)
-          return true;
-        if (p.material[i] < 0) // left the grid (saved by one rank): dropped here, counted once
-          {
-            if (rank == 0)
-              {
-                ++s.n_dropped;
-                s.dropped_mass += p.mass[i];
-              }
-            return false;
-          }
+    if (s.parallel)
+      saved = saved.selected([&](const int i) {
         double x[dim];
         for (int d = 0; d < dim; ++d)
-          x[d] = p.position[d][i];
-        return p.material[i] >= 0 && s.grid->owned_cell(s.grid->lattice_cell_of(x)) != s.grid->triangulation.end();
+          x[d] = saved.points.position[d][i];
+        return s.grid->owned_cell(s.grid->lattice_cell_of(x)) != s.grid->triangulation.end();
       });
     AssertThrow(saved.points.n_state_variables() == static_cast<int>(parameters.state_variable_names().size()),
                 dealii::ExcMessage("--resume: the points of '" + folder + "': " +

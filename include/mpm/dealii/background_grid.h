@@ -42,13 +42,25 @@ namespace mpm
   template <int dim>
   HostGrid<dim, double> lattice_grid(const Parameters &parameters, bool nodal_arrays = true);
 
+  // Work of a cell for p4est's weighted partition (deal.II's 'weight' signal, no base
+  // weight): an empty cell costs 1 unit (node updates), each point Parallel/Point weight
+  // units. Integer weights: scaled by 16 so that fractional point weights keep their
+  // meaning. p4est reads each cell's weight as an int: capped there (a Point weight of 1e9
+  // wrapped around to a negative weight, and p4est's partition aborted).
+  unsigned int cell_partition_weight(double n_points, double point_weight);
+
   template <int dim>
   class BackgroundGrid
   {
   public:
     using Vector = dealii::LinearAlgebra::distributed::Vector<double>;
 
-    BackgroundGrid(const Parameters &parameters, MPI_Comm communicator);
+    // start_points (several ranks; every rank gives all of them): the points the run starts
+    // with. The grid is then partitioned by their work as p4est refines it (the weights of
+    // MaterialPoints' repartition), so that they need not move in a repartition after they
+    // are inserted: the same partition, without building the DoFs twice.
+    BackgroundGrid(const Parameters &parameters, MPI_Comm communicator,
+                   const std::vector<const HostPoints<dim, double> *> &start_points = {});
 
     // (Re)builds everything that depends on the partition: DoFs, the partitioner,
     // the nodal vectors, the lattice lookups and the boundary masks. Called by the

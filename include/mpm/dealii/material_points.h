@@ -12,6 +12,7 @@
 
 #include <boost/signals2/connection.hpp>
 
+#include <functional>
 #include <memory>
 
 #include <string>
@@ -73,6 +74,9 @@ namespace mpm
     // handler would hold after a hand-over. values holds
     // PropertyLayout<dim>::n_properties(points.n_state_variables()) entries.
     void properties(int i, double *values) const;
+
+    // The points i for which keep(i) holds, with their labels, in their order.
+    PointSnapshot selected(const std::function<bool(int)> &keep) const;
   };
 
   // The message of points whose number of state variables is not the run's (names).
