@@ -43,6 +43,26 @@ namespace
     return true;
   }
 
+  // visit(k) for every k of the box lower[d] <= k[d] < lower[d] + width[d].
+  template <int dim, typename Visit>
+  void for_each_in_box(const int lower[dim], const int width[dim], Visit &&visit)
+  {
+    long n = 1;
+    for (int d = 0; d < dim; ++d)
+      n *= width[d];
+    for (long o = 0; o < n; ++o)
+      {
+        int  k[dim];
+        long r = o;
+        for (int d = 0; d < dim; ++d)
+          {
+            k[d] = lower[d] + static_cast<int>(r % width[d]);
+            r /= width[d];
+          }
+        visit(k);
+      }
+  }
+
   // Random exchanged nodes and cells: a few random boxes of them (as a partition's
   // boundary makes layers), nodes and cells in boxes of their own.
   template <int dim>
@@ -106,23 +126,17 @@ namespace
           }
         auto any_in_window = [&](const int lower, const int upper, const int sizes[dim],
                                  const std::vector<std::uint8_t> &marks) {
-          const int width = upper - lower + 1;
-          long      n_offsets = 1;
+          int from[dim], width[dim];
           for (int d = 0; d < dim; ++d)
-            n_offsets *= width;
-          for (long o = 0; o < n_offsets; ++o)
             {
-              int  k[dim];
-              long r = o;
-              for (int d = 0; d < dim; ++d)
-                {
-                  k[d] = home[d] + lower + static_cast<int>(r % width);
-                  r /= width;
-                }
-              if (inside<dim>(k, sizes) && marks[lattice_index<dim>(k, sizes)])
-                return true;
+              from[d]  = home[d] + lower;
+              width[d] = upper - lower + 1;
             }
-          return false;
+          bool any = false;
+          for_each_in_box<dim>(from, width, [&](const int k[dim]) {
+            any = any || (inside<dim>(k, sizes) && marks[lattice_index<dim>(k, sizes)]);
+          });
+          return any;
         };
         flags[c] = any_in_window(overlap_node_window_lower, overlap_node_window_upper, node_sizes, is_node) ||
                    any_in_window(overlap_cell_window_lower, overlap_cell_window_upper, n_cells, is_cell);
@@ -178,43 +192,24 @@ namespace
             double w[Shape::n_per_direction], dw[Shape::n_per_direction];
             stencil_weights_1d<Shape>(s[d], 0.01 + 0.99 * unit(random), n_cells[d], first[d], w, dw);
           }
-        constexpr int n       = Shape::n_per_direction;
-        long          n_sten  = 1;
+        int n_per_direction[dim];
         for (int d = 0; d < dim; ++d)
-          n_sten *= n;
-        for (long o = 0; o < n_sten; ++o)
-          {
-            int  k[dim];
-            long r = o;
-            for (int d = 0; d < dim; ++d)
-              {
-                k[d] = first[d] + static_cast<int>(r % n);
-                r /= n;
-              }
-            if (inside<dim>(k, node_sizes) && is_node[lattice_index<dim>(k, node_sizes)])
-              ++reached;
-          }
+          n_per_direction[d] = Shape::n_per_direction;
+        for_each_in_box<dim>(first, n_per_direction, [&](const int k[dim]) {
+          if (inside<dim>(k, node_sizes) && is_node[lattice_index<dim>(k, node_sizes)])
+            ++reached;
+        });
         // Every cell the point can be in after a further move of up to a cell.
-        int  lowest[dim];
-        long n_moved = 1;
+        int lowest[dim], width[dim];
         for (int d = 0; d < dim; ++d)
           {
             lowest[d] = static_cast<int>(std::floor(s[d] - 1));
-            n_moved *= static_cast<int>(std::floor(s[d] + 1)) - lowest[d] + 1;
+            width[d]  = static_cast<int>(std::floor(s[d] + 1)) - lowest[d] + 1;
           }
-        for (long o = 0; o < n_moved; ++o)
-          {
-            int  moved[dim];
-            long r = o;
-            for (int d = 0; d < dim; ++d)
-              {
-                const int width = static_cast<int>(std::floor(s[d] + 1)) - lowest[d] + 1;
-                moved[d]        = lowest[d] + static_cast<int>(r % width);
-                r /= width;
-              }
-            if (inside<dim>(moved, n_cells) && is_cell[lattice_index<dim>(moved, n_cells)])
-              ++reached;
-          }
+        for_each_in_box<dim>(lowest, width, [&](const int moved[dim]) {
+          if (inside<dim>(moved, n_cells) && is_cell[lattice_index<dim>(moved, n_cells)])
+            ++reached;
+        });
       }
     std::printf("  %dD %s: %ld points in unflagged cells, %ld reached an exchanged entry\n", dim, name, placed,
                 reached);

@@ -1216,6 +1216,16 @@ namespace mpm
     auto sum_nodal = [&](Real *const *arrays, const int count) {
       return [&exchange, arrays, count]() { exchange.sum_nodal(arrays, count); };
     };
+    // P2G of mass, momentum and force (applying a deferred averaging), then their sums.
+    auto particles_to_grid_then_sum = [&](void *stencils) {
+      pass_then_sum(
+        exchange, n_first, p,
+        [&](const PointsView<dim, Real> &q) {
+          particles_to_grid<dim, Shape, physics>(backend, g, q, s, true, true, stencils, apply_pending);
+          affine_momentum(q);
+        },
+        ExchangedEntries::nodes, p2g_sums, 2 * dim + 1, sum_nodal(p2g_sums, 2 * dim + 1));
+    };
     Real *cell_sums[2] = {g.cell_volume, g.cell_pressure_volume};
     // The kinematics pass, then the averaging's cell sums where it scattered them.
     auto kinematics_then_cell_sums = [&](auto &&kinematics) {
@@ -1240,13 +1250,7 @@ namespace mpm
               stencils = backend.point_scratch(p.n_points, sizeof(HostStencil<dim, Shape, Real>));
 #endif
             reset_grid(backend, g, true, s.pressure_averaging && !apply_pending);
-            pass_then_sum(
-              exchange, n_first, p,
-              [&](const PointsView<dim, Real> &q) {
-                particles_to_grid<dim, Shape, physics>(backend, g, q, s, true, true, stencils, apply_pending);
-                affine_momentum(q);
-              },
-              ExchangedEntries::nodes, p2g_sums, 2 * dim + 1, sum_nodal(p2g_sums, 2 * dim + 1));
+            particles_to_grid_then_sum(stencils);
             update_grid(backend, g, s, dt, true, apply_pending);
             pass_then_sum(
               exchange, n_first, p,
@@ -1266,13 +1270,7 @@ namespace mpm
 
         case UpdateScheme::usl:
           reset_grid(backend, g, true, s.pressure_averaging && !apply_pending);
-          pass_then_sum(
-            exchange, n_first, p,
-            [&](const PointsView<dim, Real> &q) {
-              particles_to_grid<dim, Shape, physics>(backend, g, q, s, true, true, nullptr, apply_pending);
-              affine_momentum(q);
-            },
-            ExchangedEntries::nodes, p2g_sums, 2 * dim + 1, sum_nodal(p2g_sums, 2 * dim + 1));
+          particles_to_grid_then_sum(nullptr);
           update_grid(backend, g, s, dt, false, apply_pending);
           grid_to_particle_velocity<dim, Shape, physics>(backend, g, p, s);
           kinematics_then_cell_sums([&](const PointsView<dim, Real> &q) {
