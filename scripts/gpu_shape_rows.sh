@@ -4,7 +4,8 @@
 # Jaumann) timed against an older tree's build, interleaved. Everything goes to $OUT.
 #   scripts/gpu_shape_rows.sh [OLD_TREE]      OLD_TREE: a checkout of the earlier commit
 #   ROWS=0: only the default against the old tree; ROWS=physics: TPIC, APIC and Hencky beside
-#   their standard rows; ROWS=cpdi: CPDI (blend, TPIC) beside cpGIMP U. TESTS=0: no tests;
+#   their standard rows; ROWS=cpdi: CPDI (blend, TPIC) beside cpGIMP U; ROWS=old: linear,
+#   uGIMP and the quadratic B-spline against the old tree too, in turn. TESTS=0: no tests;
 #   TESTS="a b": those tests
 set -u -o pipefail
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
@@ -37,6 +38,12 @@ row() { echo "== $* ($(date +%T))"; timeout 150 "$@" $P 2>&1 | grep -E "^\| " | 
     for round in 1 2; do
       row /tmp/old/benchmarks/p1_benchmark
       row /tmp/new/benchmarks/p1_benchmark
+    done
+  fi
+  if [ "${ROWS:-1}" = old ] && [ -n "$OLD" ]; then # the other stencil widths, old and new in turn
+    for shape in "--shape linear" "--domain none" "--shape bspline2"; do
+      row /tmp/old/benchmarks/p1_benchmark $shape
+      row /tmp/new/benchmarks/p1_benchmark $shape
     done
   fi
   if [ "${ROWS:-1}" = physics ]; then # the affine transfers and Hencky (DevicePhysics::all) beside the standard rows

@@ -70,6 +70,18 @@ namespace mpm
   // returns whether the whole stencil of n nodes per direction lies inside the lattice or
   // the box (then the node of stencil offset o is grid.node_at(base + o), with no bounds
   // check per node).
+  // Where every form of the stencil loop starts: the first node of the point's stencil and
+  // the 1D weights and derivatives (cell units) per direction.
+  template <int dim, typename Shape, typename Real, int n>
+  MPM_HOST_DEVICE inline void stencil_weights(const GridView<dim, Real> &grid, const Real x[dim],
+                                              const Real half_length[dim], const Real inv_h, int (&first)[dim],
+                                              Real (&w)[dim][n], Real (&dw)[dim][n])
+  {
+    for (int d = 0; d < dim; ++d)
+      stencil_weights_1d<Shape>((x[d] - grid.origin[d]) * inv_h, half_length[d] * inv_h, grid.n_cells[d], first[d], w[d],
+                                dw[d]);
+  }
+
   template <int dim, int n, typename Real>
   MPM_HOST_DEVICE inline bool stencil_base(const GridView<dim, Real> &grid, const int first[dim], long stride[dim],
                                            long &base)
@@ -144,9 +156,7 @@ namespace mpm
     HostStencil(const GridView<dim, Real> &grid, const Real x[dim], const Real half_length[dim])
       : inv_h(Real(1) / grid.h)
     {
-      for (int d = 0; d < dim; ++d)
-        stencil_weights_1d<Shape>((x[d] - grid.origin[d]) * inv_h, half_length[d] * inv_h, grid.n_cells[d], first[d], w[d],
-                                 dw[d]);
+      stencil_weights<dim, Shape>(grid, x, half_length, inv_h, first, w, dw);
     }
 
     template <typename Visitor>
@@ -249,9 +259,7 @@ namespace mpm
     int           first[dim];
     Real          w[dim][n], dw[dim][n];
     const Real    inv_h = Real(1) / grid.h;
-    for (int d = 0; d < dim; ++d)
-      stencil_weights_1d<Shape>((x[d] - grid.origin[d]) * inv_h, half_length[d] * inv_h, grid.n_cells[d], first[d], w[d],
-                                 dw[d]);
+    stencil_weights<dim, Shape>(grid, x, half_length, inv_h, first, w, dw);
 
 #  if !defined(MPM_UNROLL_STENCIL)
     constexpr int n_stencil = dim == 2 ? n * n : n * n * n;
@@ -345,9 +353,7 @@ namespace mpm
         int           first[dim];
         Real          w[dim][n], dw[dim][n];
         const Real    inv_h = Real(1) / grid.h;
-        for (int d = 0; d < dim; ++d)
-          stencil_weights_1d<Shape>((x[d] - grid.origin[d]) * inv_h, half_length[d] * inv_h, grid.n_cells[d], first[d], w[d],
-                                    dw[d]);
+        stencil_weights<dim, Shape>(grid, x, half_length, inv_h, first, w, dw);
         visit_stencil_with_offset<dim, n>(grid, first, w, dw, inv_h, x, visit);
       }
   }

@@ -320,8 +320,7 @@ namespace mpm
       const Real inv_h = Real(1) / g.h;
       int        first[dim];
       Real       w[dim][n], dw[dim][n];
-      for (int d = 0; d < dim; ++d)
-        stencil_weights_1d<Shape>((x[d] - g.origin[d]) * inv_h, lp[d] * inv_h, g.n_cells[d], first[d], w[d], dw[d]);
+      stencil_weights<dim, Shape>(g, x, lp, inv_h, first, w, dw);
       long       lattice_stride[dim], base;
       const bool inside = stencil_base<dim, n>(g, first, lattice_stride, base);
 
