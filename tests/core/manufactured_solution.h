@@ -172,19 +172,20 @@ namespace mpm_test
   };
 
   // Runs the motion over `periods` periods on n x n cells with 2 x 2 points per cell, at CFL `cfl`
-  // on the P-wave speed plus the largest point speed.
-  template <typename Shape>
-  MmsResult run_manufactured_solution(const AxisAlignedMotion &motion, const MmsMethod &method, const int n_cells,
+  // on the P-wave speed plus the largest point speed; the step in Real (double or float), the
+  // motion, the body force and the errors in double.
+  template <typename Shape, typename Real = double>
+  MmsResult run_manufactured_solution_with(const AxisAlignedMotion &motion, const MmsMethod &method, const int n_cells,
                                       const double cfl = 0.2, const double periods = 1)
   {
     using namespace mpm;
     constexpr int dim = 2;
     const double  L = motion.length, h = L / n_cells, t_end = periods * motion.period;
 
-    HostGrid<dim, double> grid;
-    const double          lower[dim] = {0, 0}, upper[dim] = {L, L};
-    const int             cells[dim] = {n_cells, n_cells};
-    grid.make_dense(lower, h, cells);
+    HostGrid<dim, Real> grid;
+    const Real          lower[dim] = {0, 0}, upper[dim] = {Real(L), Real(L)};
+    const int           cells[dim] = {n_cells, n_cells};
+    grid.make_dense(lower, Real(h), cells);
     for (long n = 0; n < long(grid.lattice_to_node.size()); ++n)
       {
         int idx[dim];
@@ -195,11 +196,12 @@ namespace mpm_test
             grid.fixed_components[n] |= std::uint8_t(1u << d);
       }
 
-    HostPoints<dim, double> points;
-    add_points(points, grid, lower, upper, BodyDescription<dim, double>{2, motion.density, {0, 0}, 0},
-               [](const double *) { return true; });
+    HostPoints<dim, Real> points;
+    add_points(points, grid, lower, upper, BodyDescription<dim, Real>{2, Real(motion.density), {0, 0}, 0},
+               [](const Real *) { return true; });
     const int                 n = points.size();
-    const std::vector<double> X[dim] = {points.position[0], points.position[1]};
+    const std::vector<double> X[dim] = {std::vector<double>(points.position[0].begin(), points.position[0].end()),
+                                        std::vector<double>(points.position[1].begin(), points.position[1].end())};
     // state variables: the body force (2), then APIC's affine matrix (4), then CPDI2q's corners (8)
     const int  body_force = 0, affine = 2;
     const bool corners    = Shape::tracks_corners;
@@ -214,13 +216,13 @@ namespace mpm_test
               points.state_variables[affine + d * dim + e][i] = d == e ? motion.velocity_gradient(X[d][i], 0) : 0;
         }
 
-    MaterialParameters<double> material{};
+    MaterialParameters<Real> material{};
     material.model                  = MaterialModel::linear_elastic;
     material.elastic.youngs_modulus = motion.youngs_modulus;
     material.elastic.poissons_ratio = motion.poissons_ratio;
     material.elastic_law            = method.law;
 
-    StepSettings<dim, double> s;
+    StepSettings<dim, Real> s;
     s.scheme                    = UpdateScheme::musl;
     s.gravity[0] = s.gravity[1] = 0;
     s.damping                   = 0;
@@ -264,9 +266,9 @@ namespace mpm_test
       r.stress_error       = std::max(r.stress_error, std::isfinite(es) ? es : HUGE_VAL);
     };
 
-    CpuTarget<dim, double> target(grid, points, {material});
-    auto                   gv        = target.grid();
-    const auto             pv        = target.points();
+    CpuTarget<dim, Real> target(grid, points, {material});
+    auto                 gv        = target.grid();
+    const auto           pv        = target.points();
     double                 t         = 0, max_speed = motion.amplitude * motion.omega();
     const double           c         = motion.p_wave_speed();
     const auto             started   = std::chrono::steady_clock::now();
@@ -282,7 +284,7 @@ namespace mpm_test
             for (int d = 0; d < dim; ++d)
               points.state_variables[body_force + d][i] = g[d];
           }
-        max_speed = explicit_step<dim, Shape>(target.backend, gv, pv, target.material_table(), s, dt).max_speed;
+        max_speed = explicit_step<dim, Shape>(target.backend, gv, pv, target.material_table(), s, Real(dt)).max_speed;
         t += dt;
         ++r.n_steps;
         const auto before = std::chrono::steady_clock::now();
@@ -297,24 +299,25 @@ namespace mpm_test
     return r;
   }
 
-  // The same with the method's shape function chosen at run time.
-  inline MmsResult run_manufactured_solution(const AxisAlignedMotion &motion, const MmsMethod &method,
-                                             const int n_cells, const double cfl = 0.2, const double periods = 1)
+  // The same with the method's shape function chosen at run time (Real: the step's precision).
+  template <typename Real = double>
+  MmsResult run_manufactured_solution(const AxisAlignedMotion &motion, const MmsMethod &method, const int n_cells,
+                                      const double cfl = 0.2, const double periods = 1)
   {
     switch (method.shape)
       {
         case MmsShape::linear:
-          return run_manufactured_solution<mpm::LinearShape>(motion, method, n_cells, cfl, periods);
+          return run_manufactured_solution_with<mpm::LinearShape, Real>(motion, method, n_cells, cfl, periods);
         case MmsShape::gimp:
-          return run_manufactured_solution<mpm::GimpShape>(motion, method, n_cells, cfl, periods);
+          return run_manufactured_solution_with<mpm::GimpShape, Real>(motion, method, n_cells, cfl, periods);
         case MmsShape::quadratic_bspline:
-          return run_manufactured_solution<mpm::QuadraticBSplineShape>(motion, method, n_cells, cfl, periods);
+          return run_manufactured_solution_with<mpm::QuadraticBSplineShape, Real>(motion, method, n_cells, cfl, periods);
         case MmsShape::cubic_bspline:
-          return run_manufactured_solution<mpm::CubicBSplineShape>(motion, method, n_cells, cfl, periods);
+          return run_manufactured_solution_with<mpm::CubicBSplineShape, Real>(motion, method, n_cells, cfl, periods);
         case MmsShape::cpdi:
-          return run_manufactured_solution<mpm::CpdiShape>(motion, method, n_cells, cfl, periods);
+          return run_manufactured_solution_with<mpm::CpdiShape, Real>(motion, method, n_cells, cfl, periods);
         case MmsShape::cpdi2q:
-          return run_manufactured_solution<mpm::Cpdi2qShape>(motion, method, n_cells, cfl, periods);
+          return run_manufactured_solution_with<mpm::Cpdi2qShape, Real>(motion, method, n_cells, cfl, periods);
       }
     throw std::logic_error("run_manufactured_solution: unknown shape");
   }
