@@ -9,13 +9,16 @@ convergence plot. doc/methods.md ("The study") gives the results.
 
   study.py --exe build/dealii-mpm --out DIR [--scenes v1,v2,v3,mms] [--methods a,b] [--reduced]
            [--csv FILE [--merge]] [--figures DIR] [--check] [--mms-exe build/tests/core/mms_study]
-           [--backend cpu|cuda]
+           [--backend cpu|cuda] [--precisions FP64,FP32]
 
 --merge: keep the rows already in --csv except those this run measures again (same scene, method, h and
 backend), and draw the charts from all of them (a method added to an existing study).
 
 --backend cuda: the runs through dealii-mpm with Backend = cuda (a build with CUDA, on a GPU machine; TPIC,
 APIC and Hencky run on the CPU only and are refused there; the MMS runs in the core on the CPU whatever this says).
+
+--precisions FP64,FP32: also the runs with the step in float, for the scenes that can (the MMS, whose core
+program takes --precision; dealii-mpm is FP64 only, so its scenes run in FP64 whatever this says).
 
 --reduced: the coarse levels only (the ctest); --check: assert that every run is stable and its error
 within the scene's bound (not the times), exit 1 if one is not. The bounds are what a usable method
@@ -126,10 +129,11 @@ COLUMNS = ["scene", "method", "h", "points", "steps", "wall_s", "point_updates_p
            "precision", "backend", "machine", "date", "details"]
 
 
-def run_mms(mms_exe, method, h):
+def run_mms(mms_exe, method, h, precision="FP64"):
     cells = int(round(1.0 / h))
-    done = subprocess.run([mms_exe, "--methods", method, "--cells", str(cells)], capture_output=True, text=True)
-    row = {"scene": "mms", "method": method, "h": h, "precision": "FP64", "backend": "cpu",
+    done = subprocess.run([mms_exe, "--methods", method, "--cells", str(cells), "--precision", precision[2:]],
+                          capture_output=True, text=True)
+    row = {"scene": "mms", "method": method, "h": h, "precision": precision, "backend": "cpu",
            "machine": mpm_runs.machine(), "date": mpm_runs.today()}
     if done.returncode != 0:
         row.update(points="", steps="", wall_s=float("nan"), point_updates_per_s="", error="", stable="no",
@@ -151,9 +155,9 @@ def gpu_name():
         return "unknown GPU"
 
 
-def run_one(exe, out_root, scene, method, h, overrides, mms_exe=None, backend="cpu"):
+def run_one(exe, out_root, scene, method, h, overrides, mms_exe=None, backend="cpu", precision="FP64"):
     if scene == "mms":
-        return run_mms(mms_exe, method, h)
+        return run_mms(mms_exe, method, h, precision)
     prm, material, _, _, solver, error_of, _ = SCENES[scene]
     label, method_solver, method_other = METHODS[method]
     other = [f"subsection Material {material}" if x == "@material" else x for x in method_other]
@@ -201,21 +205,26 @@ def draw(rows, figures):
             continue
         fig, ax = plt.subplots(figsize=(10, 5.5))
         backends = sorted({r.get("backend", "cpu") for r in mine})
+        precisions = sorted({r.get("precision", "FP64") for r in mine}, reverse=True)
         for k, method in enumerate(METHODS):
             for backend in backends:
-                pts = [(float(r["wall_s"]), float(r["error"])) for r in mine
-                       if r["method"] == method and r.get("backend", "cpu") == backend]
-                if pts:
-                    hollow = {"mfc": "none"} if backend == "cuda" else {}
-                    label = METHODS[method][0] + (" (cuda)" if backend == "cuda" else "")
-                    ax.loglog(*zip(*pts), markers[k % len(markers)], label=label, alpha=0.8,
-                              color=plt.cm.tab20(k % 20),
-                              **hollow)
+                for precision in precisions:
+                    pts = [(float(r["wall_s"]), float(r["error"])) for r in mine
+                           if r["method"] == method and r.get("backend", "cpu") == backend
+                           and r.get("precision", "FP64") == precision]
+                    if pts:
+                        style = {"mfc": "none"} if backend == "cuda" else {}
+                        if precision == "FP32":  # a smaller marker edged in black
+                            style.update(ms=4, mec="k")
+                        label = (METHODS[method][0] + (" (cuda)" if backend == "cuda" else "")
+                                 + (" FP32" if precision == "FP32" else ""))
+                        ax.loglog(*zip(*pts), markers[k % len(markers)], label=label, alpha=0.8,
+                                  color=plt.cm.tab20(k % 20), **style)
         pts = [(float(r["wall_s"]), float(r["error"])) for r in mine]
         front = [pts[i] for i in pareto_front(pts)]
         ax.step(*zip(*front), where="post", color="k", lw=1, label="Pareto front")
-        ax.set_xlabel("wall time (s), FP64" + ("; filled: CPU backend, hollow: CUDA" if "cuda" in backends else
-                                               ", CPU backend"))
+        ax.set_xlabel("wall time (s), " + ("FP64 and FP32 (small, black edge)" if "FP32" in precisions else "FP64")
+                      + ("; filled: CPU backend, hollow: CUDA" if "cuda" in backends else ", CPU backend"))
         ax.set_ylabel("error")
         where = sorted({r["machine"] for r in mine})
         ax.set_title(f"{scene.upper()}: error against cost ({'; '.join(where)})", fontsize=7)
@@ -225,7 +234,8 @@ def draw(rows, figures):
         plt.close(fig)
     for scene, what, title in (("v1", "V1 error norm", "V1 column"),
                                ("mms", "MMS position error / amplitude", "Manufactured solution")):
-        mine = [r for r in rows if r["scene"] == scene and r["stable"] == "yes" and r.get("backend", "cpu") == "cpu"]
+        mine = [r for r in rows if r["scene"] == scene and r["stable"] == "yes" and r.get("backend", "cpu") == "cpu"
+                and r.get("precision", "FP64") == "FP64"]
         if not mine:
             continue
         fig, ax = plt.subplots(figsize=(9, 5))
@@ -258,9 +268,14 @@ def main():
     ap.add_argument("--figures")
     ap.add_argument("--check", action="store_true")
     ap.add_argument("--backend", choices=["cpu", "cuda"], default="cpu")
+    ap.add_argument("--precisions", default="FP64", help="FP64, FP32 or both (FP32: the MMS only)")
     ap.add_argument("--mms-exe", help="the core program mms_study (default: tests/core/mms_study beside --exe)")
     args = ap.parse_args()
     mms_exe = args.mms_exe or os.path.join(os.path.dirname(os.path.abspath(args.exe)), "tests", "core", "mms_study")
+    precisions = args.precisions.split(",")
+    for p in precisions:
+        if p not in ("FP64", "FP32"):
+            sys.exit(f"study.py: --precisions: '{p}' is not one of FP64, FP32")
     rows = []
     for scene in args.scenes.split(","):
         levels, reduced = SCENES[scene][2], SCENES[scene][3]
@@ -268,15 +283,17 @@ def main():
             for h, overrides in levels:
                 if args.reduced and not any(abs(h - r) < 1e-12 for r in reduced):
                     continue
-                row = run_one(args.exe, os.path.abspath(args.out), scene, method, h, overrides, mms_exe,
-                              args.backend)
-                rows.append(row)
-                print(f"{scene} {METHODS[method][0]:32s} h={h:<8.4g} error={row['error']!s:22.22s} "
-                      f"wall={row['wall_s']:.2f}s stable={row['stable']} {row['details']}", flush=True)
+                for precision in precisions if scene == "mms" else ["FP64"]:
+                    row = run_one(args.exe, os.path.abspath(args.out), scene, method, h, overrides, mms_exe,
+                                  args.backend, precision)
+                    rows.append(row)
+                    print(f"{scene} {METHODS[method][0]:32s} {precision} h={h:<8.4g} "
+                          f"error={row['error']!s:22.22s} wall={row['wall_s']:.2f}s stable={row['stable']} "
+                          f"{row['details']}", flush=True)
     all_rows = rows
     if args.merge and args.csv and os.path.exists(args.csv):
         def key(r):
-            return (r["scene"], r["method"], float(r["h"]), r.get("backend", "cpu"))
+            return (r["scene"], r["method"], float(r["h"]), r.get("backend", "cpu"), r.get("precision", "FP64"))
         measured = {key(r) for r in rows}
         kept = [r for r in csv.DictReader(open(args.csv)) if key(r) not in measured]
         all_rows = kept + rows
