@@ -11,8 +11,8 @@ convergence plot. doc/methods.md ("The study") gives the results.
            [--csv FILE [--merge]] [--figures DIR] [--check] [--mms-exe build/tests/core/mms_study]
            [--backend cpu|cuda] [--precisions FP64,FP32]
 
---merge: keep the rows already in --csv except those this run measures again (same scene, method, h and
-backend), and draw the charts from all of them (a method added to an existing study).
+--merge: keep the rows already in --csv except those this run measures again (same scene, method, h,
+backend and precision), and draw the charts from all of them (a method added to an existing study).
 
 --backend cuda: the runs through dealii-mpm with Backend = cuda (a build with CUDA, on a GPU machine; TPIC,
 APIC and Hencky run on the CPU only and are refused there; the MMS runs in the core on the CPU whatever this says).

@@ -65,13 +65,9 @@ namespace mpm
     return stencil_weight_at<dim>(wk, dwk, inv_h, grad);
   }
 
-  // Strides (x fastest, as GridView::node) and the index of the stencil's first node in the
-  // numbering the grid computes nodes in: the lattice's (with a lookup) or its box's (without);
-  // returns whether the whole stencil of n nodes per direction lies inside the lattice or
-  // the box (then the node of stencil offset o is grid.node_at(base + o), with no bounds
-  // check per node).
-  // Where every form of the stencil loop starts: the first node of the point's stencil and
-  // the 1D weights and derivatives (cell units) per direction.
+  // Where every form of the stencil loop starts: for the point at x with the domain half lengths
+  // half_length (GIMP's; the linear hats and the B-splines ignore them), the first node of its
+  // stencil and the 1D weights and derivatives (cell units) per direction.
   template <int dim, typename Shape, typename Real, int n>
   MPM_HOST_DEVICE inline void stencil_weights(const GridView<dim, Real> &grid, const Real x[dim],
                                               const Real half_length[dim], const Real inv_h, int (&first)[dim],
@@ -82,6 +78,11 @@ namespace mpm
                                 dw[d]);
   }
 
+  // Strides (x fastest, as GridView::node) and the index of the stencil's first node in the
+  // numbering the grid computes nodes in: the lattice's (with a lookup) or its box's (without);
+  // returns whether the whole stencil of n nodes per direction lies inside the lattice or
+  // the box (then the node of stencil offset o is grid.node_at(base + o), with no bounds
+  // check per node).
   template <int dim, int n, typename Real>
   MPM_HOST_DEVICE inline bool stencil_base(const GridView<dim, Real> &grid, const int first[dim], long stride[dim],
                                            long &base)
