@@ -43,46 +43,35 @@ namespace mpm
   {
     const HostGrid<dim, double> lattice = lattice_geometry<dim>(parameters);
     HostGrid<dim, double>       grid;
-    long                        n_nodes = 1;
-    for (int d = 0; d < dim; ++d)
-      n_nodes *= lattice.n_cells[d] + 1;
     if (nodal_arrays)
       grid.make_dense(lattice.origin, lattice.h, lattice.n_cells);
     else
-      {
-        grid = lattice;
-        grid.fixed_components.assign(n_nodes, 0);
-      }
+      grid = lattice;
     // A node on face id (x min, x max, y min, ...) takes that face's mask: no-slip fixes
     // every component, free-slip the normal one, friction sets bit id of its friction
     // mask; edges and corners combine their faces'.
-    if (has_friction_face(parameters.boundary))
+    for (unsigned int id = 0; id < 2 * dim; ++id)
       {
-        grid.friction_faces.assign(n_nodes, 0);
-        for (unsigned int id = 0; id < 2 * dim; ++id)
-          grid.friction_coefficient[id] = face_friction_coefficient(parameters, id);
+        const BoundaryType type       = parameters.boundary[id];
+        grid.faces.fixed[id]          = type == BoundaryType::no_slip   ? std::uint8_t((1u << dim) - 1) :
+                                        type == BoundaryType::free_slip ? std::uint8_t(1u << (id / 2)) :
+                                                                          std::uint8_t(0);
+        grid.faces.friction[id]       = type == BoundaryType::friction;
+        grid.friction_coefficient[id] = face_friction_coefficient(parameters, id);
       }
+    if (!nodal_arrays) // the engine computes the masks of the nodes it keeps
+      return grid;
+    const long n_nodes = static_cast<long>(grid.mass.size());
+    if (grid.faces.any_friction())
+      grid.friction_faces.assign(n_nodes, 0);
     for (long l = 0; l < n_nodes; ++l)
       {
-        long          rest = l;
-        std::uint8_t &mask = grid.fixed_components[l];
-        for (int d = 0; d < dim; ++d)
-          {
-            const long i = rest % (lattice.n_cells[d] + 1);
-            rest /= lattice.n_cells[d] + 1;
-            for (const unsigned int id : {2u * d, 2u * d + 1})
-              {
-                if ((id % 2 == 0 && i != 0) || (id % 2 == 1 && i != lattice.n_cells[d]))
-                  continue;
-                const BoundaryType type = parameters.boundary[id];
-                if (type == BoundaryType::no_slip)
-                  mask |= std::uint8_t((1u << dim) - 1);
-                else if (type == BoundaryType::free_slip)
-                  mask |= std::uint8_t(1u << d);
-                else if (type == BoundaryType::friction)
-                  grid.friction_faces[l] |= std::uint8_t(1u << id);
-              }
-          }
+        int          idx[dim];
+        std::uint8_t friction = 0;
+        grid.lattice_coordinates(l, idx);
+        node_boundary_masks<dim>(grid.faces, grid.n_cells, idx, grid.fixed_components[l], friction);
+        if (friction != 0)
+          grid.friction_faces[l] = friction;
       }
     return grid;
   }

@@ -96,8 +96,7 @@ namespace mpm
           {
             this->near_material.block_cells              = active_block_cells;
             this->near_material.shape                    = shape;
-            this->near_material.lattice_fixed_components = lattice.fixed_components;
-            this->near_material.lattice_friction_faces   = lattice.friction_faces;
+            faces = lattice.faces;
             view.lattice_to_node     = nullptr;
             view.n_nodes             = 0; // (the friction coefficients are taken, the masks later)
             for (int d = 0; d < dim; ++d)
@@ -111,8 +110,7 @@ namespace mpm
         auto &near = this->near_material;
         if (this->follows_material())
           {
-            const int n_kept = device->keep_nodes_near_points(near.block_cells, near.lattice_fixed_components,
-                                                              near.lattice_friction_faces);
+            const int n_kept = device->keep_nodes_near_points(near.block_cells, faces);
             near.kept(n_kept, device->kept_nodes_are_box()); // asked after the choice
           }
       }
@@ -123,8 +121,8 @@ namespace mpm
                     dealii::ExcMessage("Internal: cells_with_mass() needs Nodes = near material."));
         HostGrid<dim, double> nodes;
         std::vector<long>     lattice_of_node;
-        device->download_kept_nodes(nodes, lattice_of_node);
-        out = lattice_cells_with_mass(nodes, lattice_of_node);
+        const GridView<dim, double> view = device->download_kept_nodes(nodes, lattice_of_node);
+        out                              = lattice_cells_with_mass(view, lattice_of_node);
       }
 
       // Several ranks: the device keeps this rank's locally relevant nodes, numbered as the
@@ -322,6 +320,7 @@ namespace mpm
     private:
       BackgroundGrid<dim>                    *shared_grid = nullptr;
       std::vector<MaterialParameters<double>> materials; // the latest table, for a rebuild
+      FaceConditions<dim>                     faces; // one rank near the material: the kept nodes' masks
       ShapeFunction                           shape;
       int                                     sort_interval = -1; // -1: the device's default
       // The partition the device's nodes were built for (kept alive, so a new one cannot

@@ -17,7 +17,7 @@ namespace mpm
     public:
       // One rank: the engine's own nodes on the lattice, no exchange. With active_block_cells
       // > 0 only those near the material (active_nodes.h), chosen when points are loaded and
-      // by refresh_active_nodes(); the lattice's boundary masks are kept to fill them.
+      // by refresh_active_nodes(); their boundary masks come from the lattice's faces.
       CpuEngine(const HostGrid<dim, double> &lattice, const std::vector<MaterialParameters<double>> &materials,
                 const ShapeFunction shape, const int active_block_cells)
         : materials(materials)
@@ -31,9 +31,8 @@ namespace mpm
           }
         this->near_material.block_cells              = active_block_cells;
         this->near_material.shape                    = shape;
-        this->near_material.lattice_fixed_components = lattice.fixed_components;
-        this->near_material.lattice_friction_faces   = lattice.friction_faces;
-        own_nodes.h = lattice.h;
+        own_nodes.faces = lattice.faces;
+        own_nodes.h     = lattice.h;
         for (int d = 0; d < dim; ++d)
           {
             own_nodes.origin[d]  = lattice.origin[d];
@@ -87,20 +86,26 @@ namespace mpm
       {
         if (!this->follows_material())
           return;
-        const auto &near   = this->near_material;
-        ActiveNodes active = nodes_near_points<dim>(own_nodes.origin, own_nodes.h, own_nodes.n_cells, near.block_cells,
-                                                    points.view(), &home_cells);
-        own_nodes.lattice_to_node = std::move(active.lattice_to_node);
-        lattice_of_node           = std::move(active.lattice_of_node);
-        const long n              = static_cast<long>(lattice_of_node.size());
+        const auto &near = this->near_material;
+        if (!chooser)
+          chooser = std::make_unique<NodeBlockChooser<dim>>(own_nodes.n_cells, near.block_cells);
+        chooser->choose(blocks_holding_points<dim>(own_nodes.origin, own_nodes.h, own_nodes.n_cells, near.block_cells,
+                                                   points.view(), &home_cells));
+        const std::vector<long> &lattice_of_node = chooser->nodes().lattice_of_node;
+        const long               n               = static_cast<long>(lattice_of_node.size());
         own_nodes.allocate_nodes(static_cast<int>(n));
-        own_nodes.friction_faces.assign(near.lattice_friction_faces.empty() ? 0 : n, 0);
+        own_nodes.friction_faces.assign(own_nodes.faces.any_friction() ? n : 0, 0);
         for (long node = 0; node < n; ++node)
-          {
-            own_nodes.fixed_components[node] = near.lattice_fixed_components[lattice_of_node[node]];
-            if (!near.lattice_friction_faces.empty())
-              own_nodes.friction_faces[node] = near.lattice_friction_faces[lattice_of_node[node]];
-          }
+          if (lattice_of_node[node] >= 0) // else beyond the lattice: never reached
+            {
+              int          idx[dim];
+              std::uint8_t friction = 0;
+              own_nodes.lattice_coordinates(lattice_of_node[node], idx);
+              node_boundary_masks<dim>(own_nodes.faces, own_nodes.n_cells, idx, own_nodes.fixed_components[node],
+                                       friction);
+              if (friction != 0)
+                own_nodes.friction_faces[node] = friction;
+            }
         own_nodes.cell_volume.assign(n, 0.0); // the cells' sums at their lowest vertex
         own_nodes.cell_pressure_volume.assign(n, 0.0);
         this->near_material.kept(n);
@@ -110,7 +115,7 @@ namespace mpm
       {
         AssertThrow(this->follows_material(),
                     dealii::ExcMessage("Internal: cells_with_mass() needs Nodes = near material."));
-        out = lattice_cells_with_mass(own_nodes, lattice_of_node);
+        out = lattice_cells_with_mass(own_view(), chooser->nodes().lattice_of_node);
       }
 
       unsigned int store(MaterialPoints<dim> &p) override
@@ -141,7 +146,10 @@ namespace mpm
           }
         for (long l = 0; l < n; ++l)
           {
-            const int node = to.lattice_to_node[this->follows_material() ? lattice_of_node[l] : l];
+            const long lattice = this->follows_material() ? chooser->nodes().lattice_of_node[l] : l;
+            if (lattice < 0) // a kept block's node beyond the lattice
+              continue;
+            const int node = to.lattice_to_node[lattice];
             to.mass[node]  = own_nodes.mass[l];
             for (int d = 0; d < dim; ++d)
               to.velocity[d][node] = own_nodes.velocity[d][l];
@@ -170,7 +178,7 @@ namespace mpm
       {
         if (shared_grid == nullptr)
           {
-            GridView<dim, double> g = make_grid_view<dim, double>(own_nodes);
+            GridView<dim, double> g = own_view();
             if (this->follows_material())
               g.cell_sums_at_nodes = true;
             else
@@ -190,11 +198,27 @@ namespace mpm
       void set_materials(const std::vector<MaterialParameters<double>> &m) override { materials = m; }
 
     private:
+      // The own nodes' view; near the material, numbered through the chooser's block table.
+      GridView<dim, double> own_view()
+      {
+        GridView<dim, double> g = make_grid_view<dim, double>(own_nodes);
+        if (chooser)
+          {
+            const NodeBlocks<dim> &blocks = chooser->nodes();
+            g.lattice_to_node             = nullptr;
+            g.block_slot                  = blocks.block_slot.data();
+            g.block_cells                 = blocks.block_cells;
+            for (int d = 0; d < dim; ++d)
+              g.node_blocks[d] = blocks.node_blocks[d];
+          }
+        return g;
+      }
+
       // One rank: the nodes and the cell sums. Several ranks: only the lattice geometry and
       // the cell sums; the nodes are shared_grid's vectors.
       HostGrid<dim, double>                   own_nodes;
       BackgroundGrid<dim>                    *shared_grid = nullptr;
-      std::vector<long> lattice_of_node; // nodes near the material: the lattice index of each
+      std::unique_ptr<NodeBlockChooser<dim>>  chooser; // nodes near the material: their block table
       std::vector<MaterialParameters<double>> materials;
       ShapeFunction                           shape;
       CpuBackend                              backend;

@@ -145,8 +145,8 @@ namespace mpm
   }
 
   template <int dim>
-  typename GridSnapshot<dim>::LatticeCells lattice_cells_with_mass(const HostGrid<dim, double> &nodes,
-                                                                   const std::vector<long>     &lattice_of_node)
+  typename GridSnapshot<dim>::LatticeCells lattice_cells_with_mass(const GridView<dim, double> &nodes,
+                                                                   const std::vector<long>      &lattice_of_node)
   {
     const int *n_cells = nodes.n_cells;
     // The cells around every node with mass: the node is vertex `corner` of the cell whose
@@ -154,10 +154,10 @@ namespace mpm
     std::vector<long> cells;
     for (std::size_t node = 0; node < lattice_of_node.size(); ++node)
       {
-        if (nodes.mass[node] == 0)
+        if (lattice_of_node[node] < 0 || nodes.mass[node] == 0)
           continue;
         int idx[dim];
-        nodes.lattice_coordinates(lattice_of_node[node], idx);
+        lattice_node_coordinates<dim>(n_cells, lattice_of_node[node], idx);
         for (int corner = 0; corner < (1 << dim); ++corner)
           {
             long cell = 0;
@@ -191,10 +191,10 @@ namespace mpm
           }
         for (int v = 0; v < n_vertices; ++v)
           {
-            long lattice = 0;
-            for (int d = dim - 1; d >= 0; --d)
-              lattice = lattice * (n_cells[d] + 1) + idx[d] + ((v >> d) & 1);
-            const int node = nodes.lattice_to_node[lattice];
+            int vertex[dim];
+            for (int d = 0; d < dim; ++d)
+              vertex[d] = idx[d] + ((v >> d) & 1);
+            const int node = nodes.node(vertex);
             if (node < 0) // not kept: no point reaches it
               continue;
             double *values = &out.vertex_values[(c * n_vertices + v) * (1 + dim)];
@@ -559,9 +559,9 @@ namespace mpm
 
   template struct GridSnapshot<2>;
   template struct GridSnapshot<3>;
-  template typename GridSnapshot<2>::LatticeCells lattice_cells_with_mass(const HostGrid<2, double> &,
+  template typename GridSnapshot<2>::LatticeCells lattice_cells_with_mass(const GridView<2, double> &,
                                                                           const std::vector<long> &);
-  template typename GridSnapshot<3>::LatticeCells lattice_cells_with_mass(const HostGrid<3, double> &,
+  template typename GridSnapshot<3>::LatticeCells lattice_cells_with_mass(const GridView<3, double> &,
                                                                           const std::vector<long> &);
   template class GridDataOut<2>;
   template class GridDataOut<3>;

@@ -122,9 +122,10 @@ namespace mpm
                       "bit for bit on the CPU, to round-off on the GPU). The grid files then show only the cells "
                       "with mass, and on one rank deal.II's grid of the whole box is not built. The GPU numbers "
                       "the kept nodes as the box around them where that box holds at most twice the kept blocks "
-                      "(no lookup per node: as fast as every node of a box that size), else through a lookup, "
-                      "as the CPU always does. One rank only for now; on several ranks each rank keeps every "
-                      "node of its part of the grid.");
+                      "(no lookup per node: as fast as every node of a box that size), else through a table with "
+                      "one entry per block of nodes, as the CPU always does (no array over the whole box, so "
+                      "the box can be far larger than the memory its nodes would take). One rank only for now; "
+                      "on several ranks each rank keeps every node of its part of the grid.");
     prm.declare_entry("Active block size", "4", Patterns::Integer(1, 64),
                       "Nodes = near material: edge of the blocks, in cells. Every cell within this many cells "
                       "of a point's cell is kept; larger blocks choose the nodes less often but keep more.");

@@ -489,7 +489,8 @@ namespace mpm
               << " of " << steps << " steps\n";
     if (s.engine->follows_material() && parameters.backend == "cuda")
       s.pcout << "  nodes near the material: numbered as the box around the material (no lookup) in "
-              << s.engine->node_choices_as_box() << " of " << s.engine->node_choices() << " choices\n";
+              << s.engine->node_choices_as_box() << " of " << s.engine->node_choices()
+              << " choices (the others through the block table)\n";
     if (s.parallel)
       {
         s.pcout << "  MPI: " << s.n_resorts << " re-sorts of the points into cells and ranks, "

@@ -283,6 +283,22 @@ namespace mpm
         }
       };
 
+      // The indices i < n with marks[i] != 0, in no fixed order, and their count.
+      __global__ void marked_indices_kernel(const long n, const std::uint8_t *marks, int *list, int *count)
+      {
+        const long i = blockIdx.x * static_cast<long>(blockDim.x) + threadIdx.x;
+        if (i < n && marks[i] != 0)
+          list[atomicAdd(count, 1)] = static_cast<int>(i);
+      }
+
+      // table[at[k]] = k (to_slot) or -1, k < m: a block table's entries set or cleared.
+      __global__ void set_table_entries_kernel(const int m, const long *at, int *table, const bool to_slot)
+      {
+        const int k = static_cast<int>(blockIdx.x * blockDim.x + threadIdx.x);
+        if (k < m)
+          table[at[k]] = to_slot ? k : -1;
+      }
+
       // to[k] = from[slot[k]], k < m: the points at the given slots, in that order.
       template <typename T>
       __global__ void gather_slots_kernel(const int m, const int *slot, const T *from, T *to)
@@ -496,11 +512,15 @@ namespace mpm
       // The last step's pressure averaging is left to the next step's P2G (explicit_step);
       // download_points finishes it first.
       bool                         averaging_pending = false;
-      // Nodes near the points (keep_nodes_near_points) through a lookup: the lattice index of
-      // each device node and the lookup on the host (both empty where the nodes are a box of
-      // the lattice: grid.box_lower, box_nodes), and the cell sums at the nodes.
-      std::vector<long>            lattice_of_node;
-      std::vector<int>             lattice_to_node;
+      // Nodes near the points (keep_nodes_near_points): chosen on the host (the chooser
+      // holds the block table and the lattice index of each node), numbered as a box of the
+      // lattice (grid.box_lower, box_nodes) or through the block table, whose device copy
+      // has the entries table_entries_set; the cell sums at the nodes.
+      std::unique_ptr<NodeBlockChooser<dim>> chooser;
+      bool                         numbered_by_blocks = false;
+      std::vector<long>            table_entries_set;
+      DeviceArray<long>            table_entries; // upload buffer
+      DeviceArray<int>             holding_list, holding_count;
       bool                         cell_sums_at_nodes = false;
       DeviceArray<std::uint8_t>    block_marks; // blocks holding a point's cell (keep_nodes_near_points)
 
@@ -532,7 +552,7 @@ namespace mpm
       // Lattice index of device node b.
       long lattice_of_device_node(const long b) const
       {
-        return lattice_of_node.empty() ? node_box().lattice_of(b, grid.n_cells) : lattice_of_node[b];
+        return numbered_by_blocks ? chooser->nodes().lattice_of_node[b] : node_box().lattice_of(b, grid.n_cells);
       }
 
       // Applies the last step's averaging if the next step's P2G was to do it.
@@ -691,7 +711,10 @@ namespace mpm
       std::vector<double> staging(dg.mass.size());
       std::vector<int>    host_node(staging.size());
       for (size_t b = 0; b < host_node.size(); ++b)
-        host_node[b] = g.node_of_lattice(impl->lattice_of_device_node(static_cast<long>(b)));
+        {
+          const long lattice = impl->lattice_of_device_node(static_cast<long>(b));
+          host_node[b]       = lattice < 0 ? -1 : g.node_of_lattice(lattice);
+        }
       auto download = [&](double *to, const DeviceArray<double> &from) {
         from.download(staging);
         for (size_t b = 0; b < staging.size(); ++b)
@@ -1037,8 +1060,7 @@ namespace mpm
     }
 
     template <int dim>
-    int DeviceEngine<dim>::keep_nodes_near_points(const int block_cells, const std::vector<std::uint8_t> &fixed,
-                                                  const std::vector<std::uint8_t> &friction)
+    int DeviceEngine<dim>::keep_nodes_near_points(const int block_cells, const FaceConditions<dim> &faces)
     {
       impl->finish_pending_averaging(); // its cell sums live in the arrays replaced below
       // On the device: every point's current cell becomes its home cell (upload order), and
@@ -1063,35 +1085,80 @@ namespace mpm
             marks[block_of_cell<dim>(cell, g.n_cells, block_cells)] = 1; // the same value from every writer
         });
       impl->home_by_slot_stale = true;
-      std::vector<std::uint8_t> holding;
-      impl->block_marks.download(holding);
-      const std::vector<std::uint8_t> kept = kept_blocks<dim>(g.n_cells, block_cells, std::move(holding));
-      NodeBox<dim>                    box;
-      ActiveNodes                     active;
-      const bool                      as_box = box_of_kept_blocks<dim>(g.n_cells, block_cells, kept, box);
-      if (!as_box)
-        active = nodes_of_kept_blocks<dim>(g.n_cells, block_cells, kept);
+      // The marked blocks listed on the device; only the list comes to the host.
+      const long n_cell_blocks = n_blocks<dim>(g.n_cells, block_cells);
+      impl->holding_list.resize(std::max<long>(std::min<long>(n_cell_blocks, n), 1));
+      impl->holding_count.resize(1);
+      impl->holding_count.fill_bytes(0);
+      const cudaStream_t stream = impl->backend.get_stream();
+      if (n > 0)
+        {
+          marked_indices_kernel<<<static_cast<unsigned int>((n_cell_blocks + 255) / 256), 256, 0, stream>>>(
+            n_cell_blocks, marks, impl->holding_list.data(), impl->holding_count.data());
+          MPM_CUDA_CHECK_LAUNCH();
+        }
+      int n_holding = 0;
+      MPM_CUDA_CHECK(
+        cudaMemcpyAsync(&n_holding, impl->holding_count.data(), sizeof(int), cudaMemcpyDeviceToHost, stream));
+      MPM_CUDA_CHECK(cudaStreamSynchronize(stream));
+      std::vector<int> holding_ints(n_holding);
+      if (n_holding > 0)
+        MPM_CUDA_CHECK(cudaMemcpy(holding_ints.data(), impl->holding_list.data(), n_holding * sizeof(int),
+                                  cudaMemcpyDeviceToHost));
+      if (!impl->chooser)
+        impl->chooser = std::make_unique<NodeBlockChooser<dim>>(g.n_cells, block_cells);
+      NodeBlockChooser<dim> &chooser = *impl->chooser;
+      chooser.choose(std::vector<long>(holding_ints.begin(), holding_ints.end()));
+      NodeBox<dim>           box;
+      const bool             as_box = box_of_kept_blocks<dim>(g.n_cells, block_cells, chooser.kept_blocks(), box);
+      const NodeBlocks<dim> &blocks = chooser.nodes();
       auto lattice_of = [&](const long node) {
-        return as_box ? box.lattice_of(node, g.n_cells) : active.lattice_of_node[node];
+        return as_box ? box.lattice_of(node, g.n_cells) : blocks.lattice_of_node[node];
       };
 
-      const long n_nodes = as_box ? box.size() : static_cast<long>(active.lattice_of_node.size());
+      const long n_nodes = as_box ? box.size() : blocks.n_nodes();
       if (n_nodes > std::numeric_limits<int>::max())
         throw std::invalid_argument("DeviceEngine: more nodes near the points than an int can count");
-      std::vector<std::uint8_t> node_fixed(n_nodes), node_friction(friction.empty() ? 0 : n_nodes);
+      std::vector<std::uint8_t> node_fixed(n_nodes, 0), node_friction(faces.any_friction() ? n_nodes : 0, 0);
       for (long node = 0; node < n_nodes; ++node)
         {
           const long lattice = lattice_of(node);
-          node_fixed[node]   = fixed[lattice];
-          if (!friction.empty())
-            node_friction[node] = friction[lattice];
+          if (lattice < 0) // a kept block's node beyond the lattice: never reached
+            continue;
+          int          idx[dim];
+          std::uint8_t friction = 0;
+          lattice_node_coordinates<dim>(g.n_cells, lattice, idx);
+          node_boundary_masks<dim>(faces, g.n_cells, idx, node_fixed[node], friction);
+          if (friction != 0)
+            node_friction[node] = friction;
         }
       if (as_box)
         impl->grid.set_box(box.lower, box.nodes, node_fixed, node_friction);
       else
-        impl->grid.set_nodes(active.lattice_to_node, node_fixed, node_friction);
-      impl->lattice_to_node    = std::move(active.lattice_to_node);
-      impl->lattice_of_node    = std::move(active.lattice_of_node);
+        {
+          // The device's table: the entries set last cleared, the kept node blocks set to
+          // their slots; allocated (every entry -1) at the first use.
+          DeviceArray<int> &table = impl->grid.block_slot;
+          if (table.size() == 0)
+            {
+              table.resize(blocks.block_slot.size());
+              table.fill_bytes(0xff); // -1
+            }
+          auto set_entries = [&](const std::vector<long> &at, const bool to_slot) {
+            if (at.empty())
+              return;
+            impl->table_entries.upload(at);
+            set_table_entries_kernel<<<static_cast<unsigned int>((at.size() + 255) / 256), 256, 0, stream>>>(
+              static_cast<int>(at.size()), impl->table_entries.data(), table.data(), to_slot);
+            MPM_CUDA_CHECK_LAUNCH();
+            MPM_CUDA_CHECK(cudaStreamSynchronize(stream)); // before the buffer is filled again
+          };
+          set_entries(impl->table_entries_set, false);
+          set_entries(chooser.kept_node_blocks(), true);
+          impl->table_entries_set = chooser.kept_node_blocks();
+          impl->grid.use_blocks(blocks.block_cells, blocks.node_blocks, node_fixed, node_friction);
+        }
+      impl->numbered_by_blocks = !as_box;
       impl->cell_sums_at_nodes = true;
       if (impl->cell_volume.size() > 0)
         {
@@ -1102,7 +1169,8 @@ namespace mpm
     }
 
     template <int dim>
-    void DeviceEngine<dim>::download_kept_nodes(HostGrid<dim, double> &nodes, std::vector<long> &lattice_of_node) const
+    GridView<dim, double> DeviceEngine<dim>::download_kept_nodes(HostGrid<dim, double> &nodes,
+                                                                 std::vector<long>     &lattice_of_node) const
     {
       impl->backend.synchronize();
       const DeviceGrid<dim, double> &dg = impl->grid;
@@ -1112,20 +1180,29 @@ namespace mpm
           nodes.origin[d]  = dg.origin[d];
           nodes.n_cells[d] = dg.n_cells[d];
         }
-      if (impl->lattice_of_node.empty()) // a box: its lookup made here
-        {
-          ActiveNodes box_nodes = nodes_of_box<dim>(dg.n_cells, impl->node_box());
-          nodes.lattice_to_node = std::move(box_nodes.lattice_to_node);
-          lattice_of_node       = std::move(box_nodes.lattice_of_node);
-        }
-      else
-        {
-          nodes.lattice_to_node = impl->lattice_to_node;
-          lattice_of_node       = impl->lattice_of_node;
-        }
       dg.mass.download(nodes.mass);
       for (int d = 0; d < dim; ++d)
         dg.velocity[d].download(nodes.velocity[d]);
+      const bool as_box = !impl->numbered_by_blocks;
+      lattice_of_node   = as_box ? lattice_of_box_nodes<dim>(dg.n_cells, impl->node_box()) :
+                                   impl->chooser->nodes().lattice_of_node;
+      GridView<dim, double> view = make_grid_view<dim, double>(nodes);
+      view.lattice_to_node       = nullptr;
+      if (as_box)
+        for (int d = 0; d < dim; ++d)
+          {
+            view.box_lower[d] = dg.box_lower[d];
+            view.box_nodes[d] = dg.box_nodes[d];
+          }
+      else
+        {
+          const NodeBlocks<dim> &blocks = impl->chooser->nodes(); // valid until the next choice
+          view.block_slot               = blocks.block_slot.data();
+          view.block_cells              = blocks.block_cells;
+          for (int d = 0; d < dim; ++d)
+            view.node_blocks[d] = blocks.node_blocks[d];
+        }
+      return view;
     }
 
     template <int dim>

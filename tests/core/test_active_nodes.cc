@@ -3,15 +3,19 @@
 // - enough: a point anywhere within active_node_margin cells (max-norm) of the cell it was
 //   in finds every node of its stencil active, for each shape function (GIMP at the largest
 //   half-length, 1/2), the B-splines' folded ghost nodes included;
-// - not more than the blocks promise: every active node lies within 2B cells of a live
-//   point's cell (its block and the neighbouring blocks);
-// - numbered in lattice order, the lookup and its inverse agreeing; removed points activate
-//   nothing; the home cells are the points' lattice cells.
+// - not more than the blocks promise: every active node lies in a node block holding a
+//   vertex of a cell of a live point's block or its neighbours (2B - 1 cells below the
+//   point's cell to 3B - 1 above);
+// - the block table and its inverse agree, every node's lattice index once; removed points
+//   activate nothing; the home cells are the points' lattice cells;
+// - a chooser that chose before gives the same table as a new one (its old entries reset),
+//   and keeps exactly the holding blocks and their neighbours.
 #include <mpm/core/active_nodes.h>
 
 #include "check.h"
 
 #include <algorithm>
+#include <cstdlib>
 #include <array>
 #include <random>
 #include <string>
@@ -21,8 +25,8 @@ namespace
 {
   using mpm_test::check;
 
-  template <typename Shape>
-  bool stencil_active(const double s_all[], const int dim, const int n_cells[], const std::vector<int> &lookup)
+  template <typename Shape, typename NodeOfLattice>
+  bool stencil_active(const double s_all[], const int dim, const int n_cells[], const NodeOfLattice &node_of)
   {
     int    first[3], n = Shape::n_per_direction;
     double w[3][4], dw[4];
@@ -48,7 +52,7 @@ namespace
             lattice += idx * stride;
             stride *= n_cells[d] + 1;
           }
-        if (nonzero && lookup[lattice] < 0)
+        if (nonzero && node_of(lattice) < 0)
           return false;
       }
     return true;
@@ -81,21 +85,41 @@ namespace
     p.material = material.data();
 
     std::vector<long>       home;
-    const mpm::ActiveNodes  nodes = mpm::nodes_near_points<dim>(origin, h, n_cells, block, p, &home);
-    const std::string       where = std::to_string(dim) + "D, blocks of " + std::to_string(block);
-    long n_lattice_nodes = 1;
+    const mpm::NodeBlocks<dim> nodes = mpm::nodes_near_points<dim>(origin, h, n_cells, block, p, &home);
+    const std::string          where = std::to_string(dim) + "D, blocks of " + std::to_string(block);
+    long n_lattice_nodes = 1, n_node_blocks = 1;
     for (int d = 0; d < dim; ++d)
-      n_lattice_nodes *= n_cells[d] + 1;
-    check(static_cast<long>(nodes.lattice_to_node.size()) == n_lattice_nodes, ("lookup size, " + where).c_str());
-    bool ordered = true;
+      {
+        n_lattice_nodes *= n_cells[d] + 1;
+        n_node_blocks *= nodes.node_blocks[d];
+      }
+    check(static_cast<long>(nodes.block_slot.size()) == n_node_blocks && nodes.block_cells == block,
+          ("one table entry per node block, " + where).c_str());
+    mpm::GridView<dim, double> view{};
+    for (int d = 0; d < dim; ++d)
+      {
+        view.n_cells[d]     = n_cells[d];
+        view.node_blocks[d] = nodes.node_blocks[d];
+      }
+    view.lattice_to_node = nullptr;
+    view.block_slot      = nodes.block_slot.data();
+    view.block_cells     = nodes.block_cells;
+    auto node_of = [&](const long lattice) { return view.node_of_lattice(lattice); };
+    // Every node's lattice index found back through the table, and each lattice node once.
+    bool             inverse = true;
+    long             n_active = 0;
+    std::vector<int> seen(n_lattice_nodes, 0);
     for (std::size_t k = 0; k < nodes.lattice_of_node.size(); ++k)
-      ordered = ordered && nodes.lattice_to_node[nodes.lattice_of_node[k]] == static_cast<int>(k) &&
-                (k == 0 || nodes.lattice_of_node[k] > nodes.lattice_of_node[k - 1]);
-    long n_active = 0;
-    for (const int node : nodes.lattice_to_node)
-      n_active += node >= 0;
-    check(ordered && n_active == static_cast<long>(nodes.lattice_of_node.size()),
-          ("lattice order, lookup and inverse, " + where).c_str());
+      if (nodes.lattice_of_node[k] >= 0)
+        {
+          ++n_active;
+          inverse = inverse && node_of(nodes.lattice_of_node[k]) == static_cast<int>(k) &&
+                    ++seen[nodes.lattice_of_node[k]] == 1;
+        }
+    long n_found = 0;
+    for (long l = 0; l < n_lattice_nodes; ++l)
+      n_found += node_of(l) >= 0;
+    check(inverse && n_found == n_active, ("block table and its inverse, " + where).c_str());
 
     // Home cells, and the cells of the live points in lattice coordinates.
     std::vector<std::array<int, 3>> live_cells;
@@ -123,6 +147,8 @@ namespace
     bool near = true;
     for (const long l : nodes.lattice_of_node)
       {
+        if (l < 0) // a node block's node beyond the lattice
+          continue;
         int  idx[3];
         long rest = l;
         for (int d = 0; d < dim; ++d)
@@ -135,12 +161,12 @@ namespace
           {
             bool inside = true;
             for (int d = 0; d < dim; ++d)
-              inside = inside && idx[d] >= c[d] - 2 * block + 1 && idx[d] <= c[d] + 2 * block;
+              inside = inside && idx[d] >= c[d] - 2 * block + 1 && idx[d] <= c[d] + 3 * block - 1;
             found = found || inside;
           }
         near = near && found;
       }
-    check(near, ("every active node within 2B cells of a point's cell, " + where).c_str());
+    check(near, ("every active node within 2B - 1 below and 3B - 1 above a point's cell, " + where).c_str());
 
     // Enough: points anywhere within the margin of their cell, each shape (the extremes of
     // the interval included), clamped into the lattice as points that stay in the grid are.
@@ -161,17 +187,58 @@ namespace
                   s[d] = std::min(std::max(s[d], 0.0), n_cells[d] - 1e-9);
                 }
               if (shape == mpm::ShapeFunction::linear)
-                all = all && stencil_active<mpm::LinearShape>(s, dim, n_cells, nodes.lattice_to_node);
+                all = all && stencil_active<mpm::LinearShape>(s, dim, n_cells, node_of);
               else if (shape == mpm::ShapeFunction::gimp)
-                all = all && stencil_active<mpm::GimpShape>(s, dim, n_cells, nodes.lattice_to_node);
+                all = all && stencil_active<mpm::GimpShape>(s, dim, n_cells, node_of);
               else if (shape == mpm::ShapeFunction::bspline2)
-                all = all && stencil_active<mpm::QuadraticBSplineShape>(s, dim, n_cells, nodes.lattice_to_node);
+                all = all && stencil_active<mpm::QuadraticBSplineShape>(s, dim, n_cells, node_of);
               else
-                all = all && stencil_active<mpm::CubicBSplineShape>(s, dim, n_cells, nodes.lattice_to_node);
+                all = all && stencil_active<mpm::CubicBSplineShape>(s, dim, n_cells, node_of);
             }
         check(all, ("every stencil node active within the margin (shape " + std::to_string(int(shape)) + "), " +
                     where).c_str());
       }
+    // Choosing again: from other holding blocks (and repeats), after a first choice.
+    {
+      const long                          total = mpm::n_blocks<dim>(n_cells, block);
+      std::uniform_int_distribution<long> pick(0, total - 1);
+      std::vector<long>                   first, second;
+      for (int k = 0; k < 6; ++k)
+        first.push_back(pick(random));
+      for (int k = 0; k < 6; ++k)
+        second.push_back(k % 3 == 2 ? second.back() : pick(random));
+      mpm::NodeBlockChooser<dim> again(n_cells, block), fresh(n_cells, block);
+      again.choose(first);
+      again.choose(second);
+      fresh.choose(second);
+      check(again.nodes().block_slot == fresh.nodes().block_slot &&
+              again.nodes().lattice_of_node == fresh.nodes().lattice_of_node &&
+              again.kept_blocks() == fresh.kept_blocks(),
+            ("a second choice as a first one, " + where).c_str());
+      // Exactly the holding blocks' 3^dim neighbourhoods, counted by brute force.
+      long n_block[3], expected = 0;
+      for (int d = 0; d < dim; ++d)
+        n_block[d] = mpm::n_blocks_along<dim>(n_cells[d], block);
+      for (long b = 0; b < total; ++b)
+        {
+          bool near_holding = false;
+          for (const long hb : second)
+            {
+              bool close = true;
+              long r1 = b, r2 = hb;
+              for (int d = 0; d < dim; ++d)
+                {
+                  close = close && std::abs(r1 % n_block[d] - r2 % n_block[d]) <= 1;
+                  r1 /= n_block[d];
+                  r2 /= n_block[d];
+                }
+              near_holding = near_holding || close;
+            }
+          expected += near_holding;
+        }
+      check(static_cast<long>(fresh.kept_blocks().size()) == expected,
+            ("the holding blocks and their neighbours kept, " + where).c_str());
+    }
     std::printf("%s: %ld of %ld nodes active\n", where.c_str(), n_active, n_lattice_nodes);
   }
 } // namespace

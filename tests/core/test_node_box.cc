@@ -1,14 +1,17 @@
 // Nodes numbered as a box of the lattice with no lookup (GridView's box: the device grids,
-// the GPU's nodes near the material), against the lattice numbered through a lookup:
+// the GPU's nodes near the material) and through a block table (the nodes near the
+// material, active_nodes.h), against the whole lattice:
 // - box_of_kept_blocks: the box holds every kept block's nodes and no more than the blocks'
 //   extent; it is called compact exactly when its blocks are at most
-//   box_blocks_per_kept_block times the kept ones; nodes_of_box numbers it in lattice order;
-// - a step on the box's nodes gives the points of a step on the whole lattice bit for bit:
+//   box_blocks_per_kept_block times the kept ones; lattice_of_box_nodes is in lattice order;
+// - a step on the box's nodes, and one on the nodes of a block table, gives the points of a
+//   step on the whole lattice bit for bit:
 //   GIMP, the quadratic B-spline (whose folding at the lattice's faces must see the lattice,
 //   not the box) and linear shapes, MUSL with pressure averaging (its cell sums at the box's
 //   nodes) and USL, a no-slip patch of the floor that the box touches, 2D and 3D, ten steps
 //   under gravity.
-// The box's lower corner one node off makes every case differ (tried).
+// The box's lower corner one node off makes every case differ (tried); so does a block
+// table whose kept blocks miss the points' neighbourhood by one block.
 #include <mpm/core/active_nodes.h>
 #include <mpm/core/backend/cpu_backend.h>
 #include <mpm/core/host_storage.h>
@@ -35,29 +38,35 @@ namespace
     for (int trial = 0; trial < 50; ++trial)
       {
         // A few random blocks holding points: near one another or far apart.
-        std::vector<std::uint8_t>          holding(n_blocks_total, 0);
+        std::vector<long>                   holding;
         std::uniform_int_distribution<long> pick(0, n_blocks_total - 1);
         const int                           n_holding = 1 + trial % 4;
         for (int k = 0; k < n_holding; ++k)
-          holding[pick(random)] = 1;
-        const std::vector<std::uint8_t> kept  = kept_blocks<dim>(n_cells, block, holding);
-        const ActiveNodes               nodes = nodes_of_kept_blocks<dim>(n_cells, block, kept);
-        NodeBox<dim>                    box;
-        const bool                      compact = box_of_kept_blocks<dim>(n_cells, block, kept, box);
-        // Every kept node inside the box, and the box's bounds reached by kept nodes.
+          holding.push_back(pick(random));
+        NodeBlockChooser<dim> chooser(n_cells, block);
+        chooser.choose(holding);
+        const std::vector<long> &kept_list = chooser.kept_blocks();
+        std::vector<std::uint8_t> kept(n_blocks_total, 0);
+        for (const long b : kept_list)
+          kept[b] = 1;
+        NodeBox<dim> box;
+        const bool   compact = box_of_kept_blocks<dim>(n_cells, block, kept_list, box);
+        // The box is the bounding box of the kept blocks' cells' vertices.
         long lo[dim], hi[dim], n_kept = 0, n_box_blocks = 1;
         for (int d = 0; d < dim; ++d)
           lo[d] = 1 << 20, hi[d] = -1;
-        for (const long l : nodes.lattice_of_node)
-          {
-            int idx[dim];
-            lattice_node_coordinates<dim>(n_cells, l, idx);
-            for (int d = 0; d < dim; ++d)
-              {
-                lo[d] = std::min(lo[d], long(idx[d]));
-                hi[d] = std::max(hi[d], long(idx[d]));
-              }
-          }
+        for (long b = 0; b < n_blocks_total; ++b)
+          if (kept[b])
+            {
+              long rest = b;
+              for (int d = 0; d < dim; ++d)
+                {
+                  const long c = rest % n_blocks_along<dim>(n_cells[d], block);
+                  rest /= n_blocks_along<dim>(n_cells[d], block);
+                  lo[d] = std::min(lo[d], c * block);
+                  hi[d] = std::max(hi[d], std::min((c + 1) * block, long(n_cells[d])));
+                }
+            }
         bool same = true;
         for (int d = 0; d < dim; ++d)
           same = same && box.lower[d] == lo[d] && box.lower[d] + box.nodes[d] - 1 == hi[d];
@@ -81,32 +90,46 @@ namespace
         for (int d = 0; d < dim; ++d)
           n_box_blocks *= box_blocks_hi[d] - box_blocks_lo[d] + 1;
         check(compact == (n_box_blocks <= box_blocks_per_kept_block * n_kept), "compact as the rule says");
-        // The box's own numbering: lattice order, the lookup and its inverse agreeing.
-        const ActiveNodes in_box = nodes_of_box<dim>(n_cells, box);
-        bool              ordered = static_cast<long>(in_box.lattice_of_node.size()) == box.size();
+        // The box's own numbering: lattice order, GridView's box and the inverse agreeing.
+        const std::vector<long> in_box = lattice_of_box_nodes<dim>(n_cells, box);
+        GridView<dim, double>   view{};
+        for (int d = 0; d < dim; ++d)
+          {
+            view.n_cells[d]   = n_cells[d];
+            view.box_lower[d] = box.lower[d];
+            view.box_nodes[d] = box.nodes[d];
+          }
+        view.lattice_to_node = nullptr;
+        bool ordered         = static_cast<long>(in_box.size()) == box.size();
         for (long b = 0; b < box.size() && ordered; ++b)
-          ordered = (b == 0 || in_box.lattice_of_node[b] > in_box.lattice_of_node[b - 1]) &&
-                    in_box.lattice_to_node[in_box.lattice_of_node[b]] == b;
+          ordered = (b == 0 || in_box[b] > in_box[b - 1]) && view.node_of_lattice(in_box[b]) == b;
         check(ordered, "the box numbered in lattice order");
       }
   }
 
-  // The points after `steps` steps on a grid numbered by `box` (empty box: the whole lattice
-  // through its lookup).
+  // The points after `steps` steps on a grid numbered by `box` or by `blocks` (neither: the
+  // whole lattice through its lookup).
   template <int dim, typename Shape>
   HostPoints<dim, double> run(const HostGrid<dim, double> &lattice, HostPoints<dim, double> p, const NodeBox<dim> *box,
-                              const StepSettings<dim, double> &s)
+                              const NodeBlocks<dim> *blocks, const StepSettings<dim, double> &s)
   {
     HostGrid<dim, double> g = lattice;
-    long                  n_nodes = static_cast<long>(lattice.mass.size());
-    if (box != nullptr)
+    if (box != nullptr || blocks != nullptr)
       {
-        n_nodes = box->size();
+        const std::vector<long> lattice_of_node =
+          box != nullptr ? lattice_of_box_nodes<dim>(lattice.n_cells, *box) : blocks->lattice_of_node;
+        const long n_nodes = static_cast<long>(lattice_of_node.size());
         g.allocate_nodes(static_cast<int>(n_nodes));
-        g.fixed_components.resize(n_nodes);
         for (long b = 0; b < n_nodes; ++b)
-          g.fixed_components[b] = lattice.fixed_components[box->lattice_of(b, lattice.n_cells)];
+          g.fixed_components[b] = lattice_of_node[b] < 0 ? 0 : lattice.fixed_components[lattice_of_node[b]];
         g.lattice_to_node.clear();
+        if (blocks != nullptr)
+          {
+            g.block_slot  = blocks->block_slot;
+            g.block_cells = blocks->block_cells;
+            for (int d = 0; d < dim; ++d)
+              g.node_blocks[d] = blocks->node_blocks[d];
+          }
         g.cell_volume.assign(n_nodes, 0);
         g.cell_pressure_volume.assign(n_nodes, 0);
       }
@@ -115,10 +138,10 @@ namespace
     for (int step = 0; step < 10; ++step)
       {
         GridView<dim, double> v = g.view();
+        v.cell_sums_at_nodes    = box != nullptr || blocks != nullptr;
         if (box != nullptr)
           {
             v.lattice_to_node    = nullptr;
-            v.cell_sums_at_nodes = true;
             for (int d = 0; d < dim; ++d)
               {
                 v.box_lower[d] = box->lower[d];
@@ -169,26 +192,38 @@ namespace
         box.lower[d] = box_lower[d];
         box.nodes[d] = box_upper[d] - box_lower[d] + 1;
       }
-    const HostPoints<dim, double> whole = run<dim, Shape>(lattice, p, nullptr, s);
-    const HostPoints<dim, double> boxed = run<dim, Shape>(lattice, p, &box, s);
-    bool   identical = true;
-    double moved     = 0;
+    // The block table: blocks of 3 cells near the points as they start (the points move
+    // less than a cell in the ten steps, within the margin).
+    const NodeBlocks<dim> blocks =
+      nodes_near_points<dim>(lattice.origin, h, lattice.n_cells, 3, HostPoints<dim, double>(p).view());
+    const HostPoints<dim, double> whole  = run<dim, Shape>(lattice, p, nullptr, nullptr, s);
+    const HostPoints<dim, double> boxed  = run<dim, Shape>(lattice, p, &box, nullptr, s);
+    const HostPoints<dim, double> tabled = run<dim, Shape>(lattice, p, nullptr, &blocks, s);
+    auto same = [&](const HostPoints<dim, double> &other) {
+      bool identical = true;
+      for (int i = 0; i < n; ++i)
+        {
+          for (int d = 0; d < dim; ++d)
+            identical = identical && whole.position[d][i] == other.position[d][i] &&
+                        whole.velocity[d][i] == other.velocity[d][i];
+          for (int c = 0; c < n_voigt; ++c)
+            identical = identical && whole.stress[c][i] == other.stress[c][i];
+        }
+      return identical;
+    };
+    double moved = 0;
     for (int i = 0; i < n; ++i)
-      {
-        for (int d = 0; d < dim; ++d)
-          {
-            identical = identical && whole.position[d][i] == boxed.position[d][i] &&
-                        whole.velocity[d][i] == boxed.velocity[d][i];
-            moved = std::max(moved, std::fabs(whole.position[d][i] - p.position[d][i]));
-          }
-        for (int c = 0; c < n_voigt; ++c)
-          identical = identical && whole.stress[c][i] == boxed.stress[c][i];
-      }
+      for (int d = 0; d < dim; ++d)
+        moved = std::max(moved, std::fabs(whole.position[d][i] - p.position[d][i]));
+    const bool        box_same = same(boxed), table_same = same(tabled);
     const std::string what = std::to_string(dim) + "D " + shape + (scheme == UpdateScheme::musl ? " MUSL" : " USL");
-    std::printf("%s: points moved up to %.3e m in 10 steps; box and lattice %s\n", what.c_str(), moved,
-                identical ? "bit-identical" : "DIFFER");
+    std::printf("%s: points moved up to %.3e m in 10 steps; box and lattice %s, block table (%ld nodes) and "
+                "lattice %s\n",
+                what.c_str(), moved, box_same ? "bit-identical" : "DIFFER", blocks.n_nodes(),
+                table_same ? "bit-identical" : "DIFFER");
     check(moved > 1e-5, (what + ": the points moved").c_str());
-    check(identical, (what + ": a step on the box's nodes gives the lattice's points bit for bit").c_str());
+    check(box_same, (what + ": a step on the box's nodes gives the lattice's points bit for bit").c_str());
+    check(table_same, (what + ": a step on a block table's nodes gives the lattice's points bit for bit").c_str());
   }
 } // namespace
 

@@ -6,7 +6,7 @@
 # - one body: the box around the material is compact, so every choice numbers the nodes as that
 #   box with no lookup;
 # - a second small block at the far end of the floor: the box around both would be mostly empty,
-#   so every choice numbers the blocks' nodes through a lookup.
+#   so every choice numbers the blocks' nodes through the block table.
 # In each, at t = 0.1 s (the nodes chosen again several times by then) the particle tables agree
 # to 1e-10 of each field's magnitude (the GPU's atomics sum in no fixed order; later the collapse
 # amplifies that round-off: the differences at 0.2 and 0.3 s, and those between two runs with

@@ -3,9 +3,10 @@
 //
 // The lattice's cells are grouped in blocks of B^dim cells. A block is active where a
 // point's cell lies in it or in one of its 3^dim - 1 neighbours, so every cell within B
-// cells (max-norm) of a point's cell is in an active block. The active nodes are the
-// vertices of the active blocks' cells, numbered in lattice order. The node numbering
-// does not change a node's sums: the points scatter in their own order whatever it is,
+// cells (max-norm) of a point's cell is in an active block. The active nodes are those
+// of the node blocks that hold a vertex of an active block's cell, found through a table
+// with one entry per block (GridView::block_slot), so that neither memory nor the work of
+// choosing them grows with the lattice. The node numbering does not change a node's sums: the points scatter in their own order whatever it is,
 // so a step over the active nodes gives the dense grid's results bit for bit as long as
 // every point's stencil stays inside them (active_node_margin).
 #pragma once
@@ -13,7 +14,10 @@
 #include <mpm/core/migration.h>
 #include <mpm/core/views.h>
 
+#include <algorithm>
 #include <cstdint>
+#include <limits>
+#include <stdexcept>
 #include <vector>
 
 namespace mpm
@@ -27,10 +31,18 @@ namespace mpm
     return safe_distance_outside_home_cell(shape) + (block_cells - 1);
   }
 
-  struct ActiveNodes
+  // Nodes kept through a block table (GridView's block_slot, block_cells, node_blocks): node
+  // block c (lattice nodes B c .. B c + B - 1 along each axis) -> slot, -1 where not kept;
+  // a kept block's nodes are slot B^dim + their offset in it, x fastest.
+  template <int dim>
+  struct NodeBlocks
   {
-    std::vector<int>  lattice_to_node; // lattice node index -> active node, -1 elsewhere
-    std::vector<long> lattice_of_node; // active node -> lattice node index
+    int               block_cells      = 0;
+    int               node_blocks[dim] = {};
+    std::vector<int>  block_slot;
+    std::vector<long> lattice_of_node; // node -> lattice node index; -1: beyond the lattice's last node
+
+    long n_nodes() const { return static_cast<long>(lattice_of_node.size()); }
   };
 
   // Blocks of block_cells^dim cells along each axis of a lattice of n_cells cells.
@@ -63,97 +75,152 @@ namespace mpm
     return n;
   }
 
-  // The blocks kept for the blocks that hold a point's cell (holding[b] != 0, one entry per
-  // block): those blocks and their neighbours.
+  // Chooses the nodes near the material, again and again, with work and memory that follow
+  // the material: from the cell blocks that hold a point (a list, any order, repeats
+  // allowed) it keeps those blocks and their 3^dim - 1 neighbours, and the node blocks that
+  // hold a vertex of a kept block's cell (cell block c: node blocks c .. c + 1 along each
+  // axis; the lattice's last node of a partial block lies in c itself), numbered in block
+  // order. Each choice touches only the kept blocks and the previous choice's: the marks
+  // per cell block and the block table stay allocated between choices (one byte and one int
+  // per block) and are reset entry by entry.
   template <int dim>
-  std::vector<std::uint8_t> kept_blocks(const int n_cells[dim], const int block_cells,
-                                        std::vector<std::uint8_t> holding)
+  class NodeBlockChooser
   {
-    long n_block[dim], total_blocks = 1;
-    for (int d = 0; d < dim; ++d)
-      {
-        n_block[d] = n_blocks_along<dim>(n_cells[d], block_cells);
-        total_blocks *= n_block[d];
-      }
-    // The mask dilated by one block along each axis in turn.
-    long stride = 1;
-    for (int d = 0; d < dim; ++d)
-      {
-        std::vector<std::uint8_t> grown(holding);
-        for (long b = 0; b < total_blocks; ++b)
-          {
-            const long i = b / stride % n_block[d];
-            if ((i > 0 && holding[b - stride]) || (i + 1 < n_block[d] && holding[b + stride]))
-              grown[b] = 1;
-          }
-        holding.swap(grown);
-        stride *= n_block[d];
-      }
-    return holding;
-  }
-
-  // The vertices of the kept blocks' cells (kept[b] != 0), numbered in lattice order.
-  template <int dim>
-  ActiveNodes nodes_of_kept_blocks(const int n_cells[dim], const int block_cells,
-                                   const std::vector<std::uint8_t> &kept_block)
-  {
-    long n_block[dim], total_blocks = 1, n_lattice_nodes = 1, node_stride[dim];
-    for (int d = 0; d < dim; ++d)
-      {
-        n_block[d]     = n_blocks_along<dim>(n_cells[d], block_cells);
-        node_stride[d] = n_lattice_nodes;
-        total_blocks *= n_block[d];
-        n_lattice_nodes *= n_cells[d] + 1;
-      }
-    // The vertices of a kept block's cells: lattice nodes B b .. B (b + 1) along each axis
-    // (clipped to the lattice), marked, then numbered in lattice order.
-    std::vector<std::uint8_t> kept(n_lattice_nodes, 0);
-    for (long b = 0; b < total_blocks; ++b)
-      {
-        if (!kept_block[b])
-          continue;
-        int  lower[dim], upper[dim], idx[dim];
-        long rest = b;
-        for (int d = 0; d < dim; ++d)
-          {
-            const int i = static_cast<int>(rest % n_block[d]);
-            rest /= n_block[d];
-            lower[d] = i * block_cells;
-            upper[d] = (i + 1) * block_cells < n_cells[d] ? (i + 1) * block_cells : n_cells[d];
-            idx[d]   = lower[d];
-          }
-        for (bool more = true; more;)
-          {
-            long lattice = 0;
-            for (int d = 0; d < dim; ++d)
-              lattice += idx[d] * node_stride[d];
-            kept[lattice] = 1;
-            more          = false;
-            for (int d = 0; d < dim && !more; ++d) // the next node of the block
-              if (++idx[d] <= upper[d])
-                more = true;
-              else
-                idx[d] = lower[d];
-          }
-      }
-    ActiveNodes nodes;
-    nodes.lattice_to_node.assign(n_lattice_nodes, -1);
-    for (long l = 0; l < n_lattice_nodes; ++l)
-      if (kept[l])
+  public:
+    NodeBlockChooser(const int n_cells_in[dim], const int block_cells)
+    {
+      long n_cell_blocks = 1, n_node_blocks = 1;
+      table.block_cells  = block_cells;
+      for (int d = 0; d < dim; ++d)
         {
-          nodes.lattice_to_node[l] = static_cast<int>(nodes.lattice_of_node.size());
-          nodes.lattice_of_node.push_back(l);
+          n_cells[d]           = n_cells_in[d];
+          cell_blocks[d]       = n_blocks_along<dim>(n_cells[d], block_cells);
+          table.node_blocks[d] = n_cells[d] / block_cells + 1;
+          n_cell_blocks *= cell_blocks[d];
+          n_node_blocks *= table.node_blocks[d];
         }
-    return nodes;
-  }
+      mark.assign(n_cell_blocks, 0);
+      table.block_slot.assign(n_node_blocks, -1);
+    }
 
-  // The active nodes from the blocks that hold a point's cell: the vertices of those blocks'
-  // and their neighbours' cells.
-  template <int dim>
-  ActiveNodes nodes_of_blocks(const int n_cells[dim], const int block_cells, std::vector<std::uint8_t> holding)
-  {
-    return nodes_of_kept_blocks<dim>(n_cells, block_cells, kept_blocks<dim>(n_cells, block_cells, std::move(holding)));
-  }
+    void choose(const std::vector<long> &holding)
+    {
+      for (const long nb : node_blocks) // the previous choice's table entries
+        table.block_slot[nb] = -1;
+      previous_node_blocks.swap(node_blocks);
+      node_blocks.clear();
+      kept.clear();
+      // Bit 1: a holding block already expanded; bit 0: kept.
+      for (const long b : holding)
+        {
+          if (mark[b] & 2)
+            continue;
+          int c[dim];
+          coordinates(b, cell_blocks, c);
+          for (int k = 0; k < n_neighbours; ++k)
+            {
+              long n  = 0;
+              bool in = true;
+              for (int d = dim - 1; d >= 0; --d)
+                {
+                  const long i = c[d] + (k / power(3, d)) % 3 - 1;
+                  in           = in && i >= 0 && i < cell_blocks[d];
+                  n            = n * cell_blocks[d] + i;
+                }
+              if (in && !(mark[n] & 1))
+                {
+                  mark[n] |= 1;
+                  kept.push_back(n);
+                }
+            }
+          mark[b] |= 2; // b is its own neighbour: kept, so cleared below
+        }
+      for (const long b : kept)
+        {
+          mark[b] = 0;
+          int c[dim];
+          coordinates(b, cell_blocks, c);
+          for (int corner = 0; corner < (1 << dim); ++corner)
+            {
+              long nb = 0;
+              bool in = true;
+              for (int d = dim - 1; d >= 0; --d)
+                {
+                  const long i = c[d] + ((corner >> d) & 1);
+                  in           = in && i < table.node_blocks[d];
+                  nb           = nb * table.node_blocks[d] + i;
+                }
+              if (in && table.block_slot[nb] == -1)
+                {
+                  table.block_slot[nb] = 0; // listed; numbered below
+                  node_blocks.push_back(nb);
+                }
+            }
+        }
+      std::sort(kept.begin(), kept.end());
+      std::sort(node_blocks.begin(), node_blocks.end());
+      long block_nodes = 1;
+      for (int d = 0; d < dim; ++d)
+        block_nodes *= table.block_cells;
+      if (static_cast<long>(node_blocks.size()) * block_nodes > std::numeric_limits<int>::max())
+        throw std::length_error("NodeBlockChooser: more nodes near the points than an int can count");
+      table.lattice_of_node.resize(node_blocks.size() * block_nodes);
+      for (std::size_t slot = 0; slot < node_blocks.size(); ++slot)
+        {
+          table.block_slot[node_blocks[slot]] = static_cast<int>(slot);
+          int c[dim];
+          coordinates(node_blocks[slot], table.node_blocks, c);
+          for (long k = 0; k < block_nodes; ++k)
+            {
+              long lattice = 0, stride = 1, r = k;
+              bool in      = true;
+              for (int d = 0; d < dim; ++d)
+                {
+                  const long i = c[d] * table.block_cells + r % table.block_cells;
+                  r /= table.block_cells;
+                  in = in && i <= n_cells[d];
+                  lattice += i * stride;
+                  stride *= n_cells[d] + 1;
+                }
+              table.lattice_of_node[slot * block_nodes + k] = in ? lattice : -1;
+            }
+        }
+    }
+
+    // The table and the lattice index of every kept node (-1: beyond the lattice).
+    const NodeBlocks<dim> &nodes() const { return table; }
+    // The kept cell blocks, in block order.
+    const std::vector<long> &kept_blocks() const { return kept; }
+    // The kept node blocks in slot order, and those of the choice before.
+    const std::vector<long> &kept_node_blocks() const { return node_blocks; }
+    const std::vector<long> &previous_kept_node_blocks() const { return previous_node_blocks; }
+
+  private:
+    static constexpr int n_neighbours = dim == 2 ? 9 : 27;
+    static int           power(const int base, const int e) { return e == 0 ? 1 : base * power(base, e - 1); }
+    static void coordinates(long b, const long along[dim], int c[dim])
+    {
+      for (int d = 0; d < dim; ++d)
+        {
+          c[d] = static_cast<int>(b % along[d]);
+          b /= along[d];
+        }
+    }
+    static void coordinates(long b, const int along[dim], int c[dim])
+    {
+      for (int d = 0; d < dim; ++d)
+        {
+          c[d] = static_cast<int>(b % along[d]);
+          b /= along[d];
+        }
+    }
+
+    int                       n_cells[dim];
+    long                      cell_blocks[dim];
+    std::vector<std::uint8_t> mark;
+    NodeBlocks<dim>           table;
+    std::vector<long>         kept, node_blocks, previous_node_blocks;
+  };
 
   // A box of lattice nodes: lower[d] .. lower[d] + nodes[d] - 1 along each axis.
   template <int dim>
@@ -189,35 +256,33 @@ namespace mpm
   // nodes between the kept blocks cost memory and the grid passes, not point work.
   constexpr long box_blocks_per_kept_block = 2;
 
-  // The box of the vertices of the kept blocks' cells (kept[b] != 0), and whether it is
-  // compact enough to number the nodes by (box_blocks_per_kept_block). No block kept: an
-  // empty box.
+  // The box of the vertices of the kept blocks' cells (a list of cell blocks), and whether
+  // it is compact enough to number the nodes by (box_blocks_per_kept_block). No block kept:
+  // an empty box.
   template <int dim>
-  bool box_of_kept_blocks(const int n_cells[dim], const int block_cells, const std::vector<std::uint8_t> &kept,
+  bool box_of_kept_blocks(const int n_cells[dim], const int block_cells, const std::vector<long> &kept,
                           NodeBox<dim> &box)
   {
-    long n_block[dim], lo[dim], hi[dim], n_kept = 0;
+    long n_block[dim], lo[dim], hi[dim];
     for (int d = 0; d < dim; ++d)
       {
         n_block[d] = n_blocks_along<dim>(n_cells[d], block_cells);
         lo[d]      = n_block[d];
         hi[d]      = -1;
       }
-    for (long b = 0; b < static_cast<long>(kept.size()); ++b)
-      if (kept[b])
-        {
-          ++n_kept;
-          long rest = b;
-          for (int d = 0; d < dim; ++d)
-            {
-              const long i = rest % n_block[d];
-              rest /= n_block[d];
-              lo[d] = i < lo[d] ? i : lo[d];
-              hi[d] = i > hi[d] ? i : hi[d];
-            }
-        }
+    for (const long b : kept)
+      {
+        long rest = b;
+        for (int d = 0; d < dim; ++d)
+          {
+            const long i = rest % n_block[d];
+            rest /= n_block[d];
+            lo[d] = i < lo[d] ? i : lo[d];
+            hi[d] = i > hi[d] ? i : hi[d];
+          }
+      }
     box = NodeBox<dim>();
-    if (n_kept == 0)
+    if (kept.empty())
       return true;
     long n_box_blocks = 1;
     for (int d = 0; d < dim; ++d)
@@ -227,34 +292,28 @@ namespace mpm
         box.nodes[d]     = static_cast<int>(upper - box.lower[d] + 1);
         n_box_blocks *= hi[d] - lo[d] + 1;
       }
-    return n_box_blocks <= box_blocks_per_kept_block * n_kept;
+    return n_box_blocks <= box_blocks_per_kept_block * static_cast<long>(kept.size());
   }
 
-  // The lookup of a box's nodes and its inverse (output, tests).
+  // The lattice index of each of a box's nodes (output, tests).
   template <int dim>
-  ActiveNodes nodes_of_box(const int n_cells[dim], const NodeBox<dim> &box)
+  std::vector<long> lattice_of_box_nodes(const int n_cells[dim], const NodeBox<dim> &box)
   {
-    long n_lattice_nodes = 1;
-    for (int d = 0; d < dim; ++d)
-      n_lattice_nodes *= n_cells[d] + 1;
-    ActiveNodes nodes;
-    nodes.lattice_to_node.assign(n_lattice_nodes, -1);
-    nodes.lattice_of_node.resize(box.size());
+    std::vector<long> lattice_of_node(box.size());
     for (long b = 0; b < box.size(); ++b)
-      {
-        nodes.lattice_of_node[b]                        = box.lattice_of(b, n_cells);
-        nodes.lattice_to_node[nodes.lattice_of_node[b]] = static_cast<int>(b);
-      }
-    return nodes;
+      lattice_of_node[b] = box.lattice_of(b, n_cells);
+    return lattice_of_node;
   }
 
-  // The active nodes for the points p (those not removed), blocks of block_cells^dim cells.
-  // home_cells, where given, receives every point's lattice cell (as GridView::lattice_cell).
+  // The cell blocks holding the points p (those not removed), each once per run of equal
+  // blocks. home_cells, where given, receives every point's lattice cell (as
+  // GridView::lattice_cell).
   template <int dim, typename Real>
-  ActiveNodes nodes_near_points(const Real origin[dim], const Real h, const int n_cells[dim], const int block_cells,
-                                const PointsView<dim, Real> &p, std::vector<long> *home_cells = nullptr)
+  std::vector<long> blocks_holding_points(const Real origin[dim], const Real h, const int n_cells[dim],
+                                          const int block_cells, const PointsView<dim, Real> &p,
+                                          std::vector<long> *home_cells = nullptr)
   {
-    std::vector<std::uint8_t> holding(n_blocks<dim>(n_cells, block_cells), 0);
+    std::vector<long> holding;
     if (home_cells != nullptr)
       home_cells->assign(p.n_points, 0);
     for (int i = 0; i < p.n_points; ++i)
@@ -265,9 +324,20 @@ namespace mpm
         const long cell = lattice_cell_containing<dim>(origin, h, n_cells, x);
         if (home_cells != nullptr)
           (*home_cells)[i] = cell;
-        if (p.material[i] >= 0)
-          holding[block_of_cell<dim>(cell, n_cells, block_cells)] = 1;
+        const long block = block_of_cell<dim>(cell, n_cells, block_cells);
+        if (p.material[i] >= 0 && (holding.empty() || holding.back() != block))
+          holding.push_back(block);
       }
-    return nodes_of_blocks<dim>(n_cells, block_cells, std::move(holding));
+    return holding;
+  }
+
+  // The nodes near the points p chosen once (tests; a run keeps its NodeBlockChooser).
+  template <int dim, typename Real>
+  NodeBlocks<dim> nodes_near_points(const Real origin[dim], const Real h, const int n_cells[dim], const int block_cells,
+                                    const PointsView<dim, Real> &p, std::vector<long> *home_cells = nullptr)
+  {
+    NodeBlockChooser<dim> chooser(n_cells, block_cells);
+    chooser.choose(blocks_holding_points<dim>(origin, h, n_cells, block_cells, p, home_cells));
+    return chooser.nodes();
   }
 } // namespace mpm

@@ -2,6 +2,7 @@
 // The CUDA backend has device twins of these (backend/cuda_storage.h).
 #pragma once
 
+#include <mpm/core/boundary_masks.h>
 #include <mpm/core/views.h>
 
 #include <cstdint>
@@ -161,8 +162,15 @@ namespace mpm
         v.velocity[d] = s.velocity[d].data();
       }
     v.h                = s.h;
-    v.lattice_to_node  = s.lattice_to_node.data();
-    v.box_is_lattice(); // where the owner has no lookup
+    v.lattice_to_node  = s.lattice_to_node.size() > 0 ? s.lattice_to_node.data() : nullptr;
+    v.box_is_lattice(); // where the owner has no lookup and no block table
+    if (s.block_slot.size() > 0)
+      {
+        v.block_slot  = s.block_slot.data();
+        v.block_cells = s.block_cells;
+        for (int d = 0; d < dim; ++d)
+          v.node_blocks[d] = s.node_blocks[d];
+      }
     v.n_nodes          = static_cast<int>(s.mass.size());
     v.mass             = s.mass.data();
     v.fixed_components = s.fixed_components.data();
@@ -187,10 +195,14 @@ namespace mpm
     Real                      h;
     int                       n_cells[dim];
     std::vector<int>          lattice_to_node;
+    std::vector<int>          block_slot; // a block table instead (views.h); empty: none
+    int                       block_cells      = 0;
+    int                       node_blocks[dim] = {};
     std::vector<Real>         mass, momentum[dim], force[dim], velocity[dim];
     std::vector<std::uint8_t> fixed_components;
     std::vector<std::uint8_t> friction_faces;                    // empty: no frictional wall (views.h)
     Real                      friction_coefficient[2 * dim] = {}; // mu of each grid face
+    FaceConditions<dim>       faces; // what each face of the lattice prescribes (the masks' source)
     std::vector<Real>         cell_volume, cell_pressure_volume; // pressure-averaging scratch, one per lattice cell
 
     // A dense grid whose node numbering is the lattice numbering (standalone use).

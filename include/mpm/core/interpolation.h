@@ -82,13 +82,20 @@ namespace mpm
   // numbering the grid computes nodes in: the lattice's (with a lookup) or its box's (without);
   // returns whether the whole stencil of n nodes per direction lies inside the lattice or
   // the box (then the node of stencil offset o is grid.node_at(base + o), with no bounds
-  // check per node).
+  // check per node). Through a block table a stencil's nodes are not one index plus
+  // offsets: false, and the callers ask GridView::node per node.
   template <int dim, int n, typename Real>
   MPM_HOST_DEVICE inline bool stencil_base(const GridView<dim, Real> &grid, const int first[dim], long stride[dim],
                                            long &base)
   {
     bool inside = true;
     base        = 0;
+    if (grid.block_slot != nullptr && grid.lattice_to_node == nullptr)
+      {
+        for (int d = 0; d < dim; ++d)
+          stride[d] = 0;
+        return false;
+      }
     if (grid.lattice_to_node != nullptr)
       for (int d = 0; d < dim; ++d)
         {

@@ -39,23 +39,31 @@ namespace mpm
       }
   }
 
-  // Uniform background lattice. Its nodes are numbered in one of two ways: through a
-  // lookup (deal.II's locally relevant DoF space, the nodes near the material), or, with
-  // no lookup, as a box of the lattice in lattice order (device grids: the whole lattice,
-  // a rank's slab, the box around the material), whose index is computed, not looked up.
+  // Uniform background lattice. Its nodes are numbered in one of three ways: through a
+  // lookup (deal.II's locally relevant DoF space); through a block table, one entry per
+  // block of nodes (the nodes near the material, active_nodes.h: memory that follows the
+  // material, not the lattice); or, with neither, as a box of the lattice in lattice order
+  // (device grids: the whole lattice, a rank's slab, the box around the material), whose
+  // index is computed, not looked up.
   template <int dim, typename Real>
   struct GridView
   {
     Real origin[dim];           // lower corner of the grid
     Real h;                     // cell size, equal in every direction
     int  n_cells[dim];          // cells per direction
-    // Lattice index -> local node index, -1 if absent. Null: the nodes are the box of
-    // lattice nodes box_lower[d] .. box_lower[d] + box_nodes[d] - 1 along each axis, x
-    // fastest, and a lattice node outside the box is absent.
+    // Lattice index -> local node index, -1 if absent. Null: the block table below or,
+    // without it, the box of lattice nodes box_lower[d] .. box_lower[d] + box_nodes[d] - 1
+    // along each axis, x fastest, a lattice node outside the box absent.
     const int *lattice_to_node;
     int        n_nodes;             // local nodes (length of the arrays below)
     int        box_lower[dim] = {}; // without a lookup: the box's first lattice node
     int        box_nodes[dim] = {}; // and its nodes along each axis (inside the lattice)
+    // Block table: node block (lattice nodes B c .. B c + B - 1 along each axis, c x
+    // fastest over node_blocks) -> slot, -1 where not kept; the block's nodes are slot B^dim
+    // + their offset in it (x fastest). Null: no block table.
+    const int *block_slot       = nullptr;
+    int        block_cells      = 0; // B
+    int        node_blocks[dim] = {};
 
     Real *mass;
     Real *momentum[dim];
@@ -113,7 +121,7 @@ namespace mpm
     MPM_HOST_DEVICE int node(const int idx[dim]) const
     {
       if (lattice_to_node == nullptr)
-        return node_in_box(idx);
+        return block_slot != nullptr ? node_in_blocks(idx) : node_in_box(idx);
       long lattice = 0;
       for (int d = dim - 1; d >= 0; --d)
         {
@@ -140,6 +148,23 @@ namespace mpm
       return static_cast<int>(node);
     }
 
+    // Through the block table: the node (i,j,k), -1 outside the lattice or not kept.
+    MPM_HOST_DEVICE int node_in_blocks(const int idx[dim]) const
+    {
+      long block = 0;
+      int  offset = 0, block_nodes = 1;
+      for (int d = dim - 1; d >= 0; --d)
+        {
+          if (idx[d] < 0 || idx[d] > n_cells[d])
+            return -1;
+          block  = block * node_blocks[d] + idx[d] / block_cells;
+          offset = offset * block_cells + idx[d] % block_cells;
+          block_nodes *= block_cells;
+        }
+      const int slot = block_slot[block];
+      return slot < 0 ? -1 : slot * block_nodes + offset;
+    }
+
     // Local node index of a lattice index inside the lattice (-1: absent).
     MPM_HOST_DEVICE int node_of_lattice(const long lattice) const
     {
@@ -147,7 +172,7 @@ namespace mpm
         return lattice_to_node[lattice];
       int idx[dim];
       lattice_node_coordinates<dim>(n_cells, lattice, idx);
-      return node_in_box(idx);
+      return block_slot != nullptr ? node_in_blocks(idx) : node_in_box(idx);
     }
 
     // The node at an index computed by stencil_base (interpolation.h): the lattice index

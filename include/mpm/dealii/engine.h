@@ -103,7 +103,6 @@ namespace mpm
     {
       int                       block_cells = 0; // 0: every node
       ShapeFunction             shape       = ShapeFunction::gimp;
-      std::vector<std::uint8_t> lattice_fixed_components, lattice_friction_faces; // of the whole lattice
       long                      now = 0, most = 0;                                 // nodes kept
       long choices = 0, as_box = 0; // choices that kept nodes, and those numbered as a box (GPU)
 

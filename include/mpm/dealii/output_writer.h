@@ -77,12 +77,13 @@ namespace mpm
     int n_cells() const { return static_cast<int>(cells.empty() ? lattice_cells.lower_corner.size() : cells.size()); }
   };
 
-  // The cells of a grid that keeps only the nodes near the material (`nodes`, numbered by
-  // its lattice_to_node; lattice_of_node the inverse) with mass at a vertex, in lattice
-  // order, and their vertices' mass and velocity (vertices not kept: zero).
+  // The cells of a grid that keeps only the nodes near the material (`nodes`: its
+  // numbering, mass and velocity; lattice_of_node the lattice index of each node, -1 for
+  // none) with mass at a vertex, in lattice order, and their vertices' mass and velocity
+  // (vertices not kept: zero).
   template <int dim>
-  typename GridSnapshot<dim>::LatticeCells lattice_cells_with_mass(const HostGrid<dim, double> &nodes,
-                                                                   const std::vector<long>     &lattice_of_node);
+  typename GridSnapshot<dim>::LatticeCells lattice_cells_with_mass(const GridView<dim, double> &nodes,
+                                                                   const std::vector<long>      &lattice_of_node);
 
   // The patches deal.II's DataOut<dim> builds for the grid's Q1 fields (one per cell: its
   // vertices, each nodal field's values at them, "subdomain" as cell data), made straight

@@ -156,6 +156,9 @@ namespace mpm
     Real                      h = 0;
     int                       n_cells[dim];
     DeviceArray<int>          lattice_to_node;
+    DeviceArray<int>          block_slot; // a block table instead (views.h), kept by the owner
+    int                       block_cells      = 0;
+    int                       node_blocks[dim] = {};
     DeviceArray<Real>         mass, momentum[dim], force[dim], velocity[dim];
     DeviceArray<std::uint8_t> fixed_components;
     DeviceArray<std::uint8_t> friction_faces; // empty: no frictional wall
@@ -182,6 +185,7 @@ namespace mpm
       for (size_t l = 0; !g.lattice_to_node.empty() && lattice_order && l < g.lattice_to_node.size(); ++l)
         lattice_order = g.lattice_to_node[l] == static_cast<int>(l);
       lattice_to_node.upload(lattice_order ? std::vector<int>() : g.lattice_to_node);
+      by_blocks = false;
       for (int d = 0; d < dim; ++d)
         {
           box_lower[d] = 0;
@@ -194,15 +198,20 @@ namespace mpm
         friction_coefficient[f] = g.friction_coefficient[f];
     }
 
-    // New nodes: n_nodes = fixed.size(), reached through `lookup` (lattice node -> node),
-    // with those masks (friction empty: no frictional face) and every nodal value zero; the
+    // New nodes: n_nodes = fixed.size(), reached through the block table block_slot (views.h;
+    // its entries set by the owner) of node blocks of `cells` nodes along each axis, with
+    // those masks (friction empty: no frictional face) and every nodal value zero; the
     // geometry stays. The memory held only grows.
-    void set_nodes(const std::vector<int> &lookup, const std::vector<std::uint8_t> &fixed,
-                   const std::vector<std::uint8_t> &friction)
+    void use_blocks(const int cells, const int blocks[dim], const std::vector<std::uint8_t> &fixed,
+                    const std::vector<std::uint8_t> &friction)
     {
       reset_nodes(fixed.size());
       lattice_order = false;
-      lattice_to_node.upload(lookup);
+      by_blocks     = true;
+      lattice_to_node.resize(0);
+      block_cells = cells;
+      for (int d = 0; d < dim; ++d)
+        node_blocks[d] = blocks[d];
       fixed_components.upload(fixed);
       friction_faces.upload(friction);
     }
@@ -224,6 +233,7 @@ namespace mpm
     void set_box(const int lower[dim], const int nodes[dim])
     {
       lattice_order = true;
+      by_blocks     = false;
       for (int d = 0; d < dim; ++d)
         {
           box_lower[d] = lower[d];
@@ -262,15 +272,19 @@ namespace mpm
     // Whether the nodes are a box of the lattice in lattice order (the view then has no
     // lookup), and that box.
     bool lattice_order = false;
+    bool by_blocks     = false; // through block_slot
     int  box_lower[dim] = {};
     int  box_nodes[dim] = {};
 
     GridView<dim, Real> view()
     {
       GridView<dim, Real> v = make_grid_view<dim, Real>(*this);
+      if (!by_blocks)
+        v.block_slot = nullptr;
       if (lattice_order)
         {
           v.lattice_to_node = nullptr;
+          v.block_slot      = nullptr;
           for (int d = 0; d < dim; ++d)
             {
               v.box_lower[d] = box_lower[d];
