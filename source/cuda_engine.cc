@@ -97,6 +97,8 @@ namespace mpm
             this->near_material.block_cells              = active_block_cells;
             this->near_material.shape                    = shape;
             faces = lattice.faces;
+            for (int f = 0; f < 2 * dim; ++f) // (the view has them only with a mask array)
+              view.friction_coefficient[f] = lattice.friction_coefficient[f];
             view.lattice_to_node     = nullptr;
             view.n_nodes             = 0; // (the friction coefficients are taken, the masks later)
             for (int d = 0; d < dim; ++d)

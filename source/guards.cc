@@ -278,7 +278,7 @@ namespace mpm
     scan_text(in, "input string", {}, scan);
   }
 
-  MemoryEstimate estimate_memory(const Parameters &p, double n_points)
+  MemoryEstimate estimate_memory(const Parameters &p, double n_points, const unsigned int n_ranks)
   {
     const unsigned int dim = p.dim;
     MemoryEstimate     e;
@@ -320,6 +320,18 @@ namespace mpm
 
     const BytesPer b = bytes_per(dim);
     e.grid_bytes     = b.cell * e.n_cells;
+    // Nodes near the material on one rank: no deal.II grid of the box; the chooser's mark
+    // and table entry per block (5 bytes per B^dim cells) and the kept nodes, about four
+    // times the cells the bodies fill (the material spreads, and a block's neighbours are
+    // kept) at the engine's nodal arrays, cell sums, numbering and grid output (500 bytes).
+    if (p.active_block_cells > 0 && n_ranks == 1)
+      {
+        double material_cells = 0;
+        for (const BodyParameters &body : p.bodies)
+          material_cells += points_of_body(body, p) / std::pow(body.points_per_direction, dim);
+        e.grid_bytes = 5 * e.n_cells / std::pow(p.active_block_cells, dim) +
+                       500 * std::min(e.n_cells, 4 * material_cells);
+      }
     e.point_bytes    = b.point * e.n_points;
     e.per_rank_bytes = b.program + b.generated_point * e.n_points + field_bytes;
     return e;
@@ -450,7 +462,7 @@ namespace mpm
   void check_memory(const Parameters &p, MPI_Comm communicator)
   {
     const unsigned int   n_ranks = dealii::Utilities::MPI::n_mpi_processes(communicator);
-    const MemoryEstimate e       = estimate_memory(p);
+    const MemoryEstimate e       = estimate_memory(p, -1, n_ranks);
     const double         GB      = 1e9;
 
     // What limits: Resources/Memory limit for the whole run, else each node's available

@@ -598,12 +598,13 @@ namespace mpm
       // the rank reaches it). download_nodal and the exchange translate to the host's
       // numbering.
       const long       layer = n_lattice_nodes / (g.n_cells[dim - 1] + 1);
-      std::vector<int> lattice_nodes(n_lattice_nodes);
-      for (long l = 0; l < n_lattice_nodes; ++l)
+      // No host node (the nodes near the material come later): no pass over the lattice.
+      std::vector<int> lattice_nodes(g.n_nodes > 0 ? n_lattice_nodes : 0);
+      for (long l = 0; l < static_cast<long>(lattice_nodes.size()); ++l)
         lattice_nodes[l] = g.node_of_lattice(l);
       long             first = -1, last = -1;
       std::vector<long> lattice_of_host(g.n_nodes, -1);
-      for (long l = 0; l < n_lattice_nodes; ++l)
+      for (long l = 0; l < static_cast<long>(lattice_nodes.size()); ++l)
         if (const int node = lattice_nodes[l]; node >= 0)
           {
             if (node >= g.n_nodes || lattice_of_host[node] >= 0)
@@ -624,14 +625,14 @@ namespace mpm
       for (long b = 0; b < n_slab; ++b)
         if (const int node = lattice_nodes[node_offset + b]; node >= 0)
           host.fixed_components[b] = g.fixed_components[node];
+      for (int f = 0; f < 2 * dim; ++f) // also where the masks come later (near the material)
+        host.friction_coefficient[f] = g.friction_coefficient[f];
       if (g.friction_faces != nullptr)
         {
           host.friction_faces.assign(n_slab, 0);
           for (long b = 0; b < n_slab; ++b)
             if (const int node = lattice_nodes[node_offset + b]; node >= 0)
               host.friction_faces[b] = g.friction_faces[node];
-          for (int f = 0; f < 2 * dim; ++f)
-            host.friction_coefficient[f] = g.friction_coefficient[f];
         }
       impl->grid.upload(host);
       int slab_lower[dim], slab_nodes[dim]; // no lookup: the slab's layers, lattice order

@@ -59,7 +59,8 @@ namespace mpm
     }
   };
   // n_points < 0: the points of the prm's bodies, counted from their volumes and point spacing.
-  MemoryEstimate estimate_memory(const Parameters &parameters, double n_points = -1);
+  // With Grid/Nodes = near material on one rank the grid costs what the kept nodes do.
+  MemoryEstimate estimate_memory(const Parameters &parameters, double n_points = -1, unsigned int n_ranks = 1);
 
   // Refuses, on every rank of `communicator` alike, a run whose estimate exceeds Resources/
   // Memory limit (where > 0) or the memory available on a node to the ranks it holds
