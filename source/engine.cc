@@ -205,11 +205,7 @@ namespace mpm
         if (chooser)
           {
             const NodeBlocks<dim> &blocks = chooser->nodes();
-            g.lattice_to_node             = nullptr;
-            g.block_slot                  = blocks.block_slot.data();
-            g.block_cells                 = blocks.block_cells;
-            for (int d = 0; d < dim; ++d)
-              g.node_blocks[d] = blocks.node_blocks[d];
+            g.set_block_table(blocks.block_slot.data(), blocks.block_cells, blocks.node_blocks);
           }
         return g;
       }

@@ -1198,10 +1198,7 @@ namespace mpm
       else
         {
           const NodeBlocks<dim> &blocks = impl->chooser->nodes(); // valid until the next choice
-          view.block_slot               = blocks.block_slot.data();
-          view.block_cells              = blocks.block_cells;
-          for (int d = 0; d < dim; ++d)
-            view.node_blocks[d] = blocks.node_blocks[d];
+          view.set_block_table(blocks.block_slot.data(), blocks.block_cells, blocks.node_blocks);
         }
       return view;
     }

@@ -97,13 +97,8 @@ namespace
           ("one table entry per node block, " + where).c_str());
     mpm::GridView<dim, double> view{};
     for (int d = 0; d < dim; ++d)
-      {
-        view.n_cells[d]     = n_cells[d];
-        view.node_blocks[d] = nodes.node_blocks[d];
-      }
-    view.lattice_to_node = nullptr;
-    view.block_slot      = nodes.block_slot.data();
-    view.block_cells     = nodes.block_cells;
+      view.n_cells[d] = n_cells[d];
+    view.set_block_table(nodes.block_slot.data(), nodes.block_cells, nodes.node_blocks);
     auto node_of = [&](const long lattice) { return view.node_of_lattice(lattice); };
     // Every node's lattice index found back through the table, and each lattice node once.
     bool             inverse = true;

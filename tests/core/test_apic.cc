@@ -191,6 +191,7 @@ int main()
     HostPoints<2, double> none;
     none.set_n_state_variables(4);
     StepSettings<2, double> s{};
+    s.flip_fraction         = 0; // APIC's (the check after it is the one tested)
     s.affine_state_variable = 0;
     s.affine_matrix         = AffineMatrix::b_d_inverse;
     CpuBackend backend;

@@ -163,14 +163,7 @@ namespace mpm
       }
     v.h                = s.h;
     v.lattice_to_node  = s.lattice_to_node.size() > 0 ? s.lattice_to_node.data() : nullptr;
-    v.box_is_lattice(); // where the owner has no lookup and no block table
-    if (s.block_slot.size() > 0)
-      {
-        v.block_slot  = s.block_slot.data();
-        v.block_cells = s.block_cells;
-        for (int d = 0; d < dim; ++d)
-          v.node_blocks[d] = s.node_blocks[d];
-      }
+    v.box_is_lattice(); // where the owner has no lookup
     v.n_nodes          = static_cast<int>(s.mass.size());
     v.mass             = s.mass.data();
     v.fixed_components = s.fixed_components.data();
@@ -251,6 +244,12 @@ namespace mpm
       lattice_node_coordinates<dim>(n_cells, lattice, idx);
     }
 
-    GridView<dim, Real> view() { return make_grid_view<dim, Real>(*this); }
+    GridView<dim, Real> view()
+    {
+      GridView<dim, Real> v = make_grid_view<dim, Real>(*this);
+      if (!block_slot.empty())
+        v.set_block_table(block_slot.data(), block_cells, node_blocks);
+      return v;
+    }
   };
 } // namespace mpm

@@ -83,26 +83,26 @@ namespace mpm
   // returns whether the whole stencil of n nodes per direction lies inside the lattice or
   // the box (then the node of stencil offset o is grid.node_at(base + o), with no bounds
   // check per node). Through a block table a stencil's nodes are not one index plus
-  // offsets: false, and the callers ask GridView::node per node.
+  // offsets: false, and the callers ask GridView::node per node; base is then the lattice
+  // index, and *in_lattice (where given) whether the stencil lies inside the lattice.
   template <int dim, int n, typename Real>
   MPM_HOST_DEVICE inline bool stencil_base(const GridView<dim, Real> &grid, const int first[dim], long stride[dim],
-                                           long &base)
+                                           long &base, bool *in_lattice = nullptr)
   {
     bool inside = true;
     base        = 0;
-    if (grid.block_slot != nullptr && grid.lattice_to_node == nullptr)
+    if (grid.lattice_to_node != nullptr)
       {
         for (int d = 0; d < dim; ++d)
-          stride[d] = 0;
-        return false;
+          {
+            stride[d] = d == 0 ? 1 : stride[d - 1] * (grid.n_cells[d - 1] + 1);
+            base += first[d] * stride[d];
+            inside = inside && first[d] >= 0 && first[d] + n - 1 <= grid.n_cells[d];
+          }
+        if (in_lattice != nullptr)
+          *in_lattice = inside;
+        return inside && grid.block_cells == 0;
       }
-    if (grid.lattice_to_node != nullptr)
-      for (int d = 0; d < dim; ++d)
-        {
-          stride[d] = d == 0 ? 1 : stride[d - 1] * (grid.n_cells[d - 1] + 1);
-          base += first[d] * stride[d];
-          inside = inside && first[d] >= 0 && first[d] + n - 1 <= grid.n_cells[d];
-        }
     else
       for (int d = 0; d < dim; ++d)
         {

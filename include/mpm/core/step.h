@@ -65,16 +65,18 @@ namespace mpm
   }
 
   template <int dim, typename Real>
+  // Defaults are the prm's (an unset field was garbage: test_gpu_device_engine once stepped
+  // with an arbitrary update scheme).
   struct StepSettings
   {
-    UpdateScheme scheme;
-    Real         gravity[dim];   // body acceleration at this step (ramp already applied)
-    Real         damping;        // local damping coefficient D
+    UpdateScheme scheme = UpdateScheme::musl;
+    Real         gravity[dim] = {}; // body acceleration at this step (ramp already applied)
+    Real         damping      = Real(0); // local damping coefficient D
     LocalDampingForm damping_form = LocalDampingForm::per_component; // local_damping.h
     Real             damping_threshold = Real(0); // nodal speeds at or below it are not damped
-    Real         flip_fraction;  // 1: pure FLIP, 0: pure PIC
-    DomainUpdate domain_update;  // uGIMP or cpGIMP variants
-    Real         mass_tolerance; // nodes lighter than this carry no velocity
+    Real         flip_fraction  = Real(1);            // 1: pure FLIP, 0: pure PIC
+    DomainUpdate domain_update  = DomainUpdate::none; // uGIMP or cpGIMP variants
+    Real         mass_tolerance = Real(0);            // nodes lighter than this carry no velocity
     // Cell-wise volume-weighted pressure averaging after the constitutive update
     // (remedy for volumetric locking); needs the grid's cell arrays.
     bool pressure_averaging = false;

@@ -51,19 +51,17 @@ namespace mpm
     Real origin[dim];           // lower corner of the grid
     Real h;                     // cell size, equal in every direction
     int  n_cells[dim];          // cells per direction
-    // Lattice index -> local node index, -1 if absent. Null: the block table below or,
-    // without it, the box of lattice nodes box_lower[d] .. box_lower[d] + box_nodes[d] - 1
-    // along each axis, x fastest, a lattice node outside the box absent.
+    // Lattice index -> local node index, -1 if absent; with block_cells > 0 the block table
+    // instead (set_block_table). Null: the nodes are the box of lattice nodes box_lower[d] ..
+    // box_lower[d] + box_nodes[d] - 1 along each axis, x fastest, a lattice node outside the
+    // box absent. (The box is tested first and the table inside the lookup's branch, so that
+    // the dense grids' kernels carry no more than before.)
     const int *lattice_to_node;
     int        n_nodes;             // local nodes (length of the arrays below)
     int        box_lower[dim] = {}; // without a lookup: the box's first lattice node
     int        box_nodes[dim] = {}; // and its nodes along each axis (inside the lattice)
-    // Block table: node block (lattice nodes B c .. B c + B - 1 along each axis, c x
-    // fastest over node_blocks) -> slot, -1 where not kept; the block's nodes are slot B^dim
-    // + their offset in it (x fastest). Null: no block table.
-    const int *block_slot       = nullptr;
-    int        block_cells      = 0; // B
-    int        node_blocks[dim] = {};
+    int        block_cells      = 0;  // > 0: lattice_to_node is a block table of blocks of B nodes per axis
+    int        node_blocks[dim] = {}; // its node blocks along each axis
 
     Real *mass;
     Real *momentum[dim];
@@ -121,7 +119,9 @@ namespace mpm
     MPM_HOST_DEVICE int node(const int idx[dim]) const
     {
       if (lattice_to_node == nullptr)
-        return block_slot != nullptr ? node_in_blocks(idx) : node_in_box(idx);
+        return node_in_box(idx);
+      if (block_cells > 0)
+        return node_in_blocks(idx);
       long lattice = 0;
       for (int d = dim - 1; d >= 0; --d)
         {
@@ -148,6 +148,17 @@ namespace mpm
       return static_cast<int>(node);
     }
 
+    // The nodes through a block table: node block (lattice nodes B c .. B c + B - 1 along
+    // each axis, c x fastest over node_blocks) -> slot, -1 where not kept; a kept block's
+    // nodes are slot B^dim + their offset in it, x fastest.
+    MPM_HOST_DEVICE void set_block_table(const int *slots, const int cells, const int blocks[dim])
+    {
+      lattice_to_node = slots;
+      block_cells     = cells;
+      for (int d = 0; d < dim; ++d)
+        node_blocks[d] = blocks[d];
+    }
+
     // Through the block table: the node (i,j,k), -1 outside the lattice or not kept.
     MPM_HOST_DEVICE int node_in_blocks(const int idx[dim]) const
     {
@@ -161,18 +172,18 @@ namespace mpm
           offset = offset * block_cells + idx[d] % block_cells;
           block_nodes *= block_cells;
         }
-      const int slot = block_slot[block];
+      const int slot = lattice_to_node[block];
       return slot < 0 ? -1 : slot * block_nodes + offset;
     }
 
     // Local node index of a lattice index inside the lattice (-1: absent).
     MPM_HOST_DEVICE int node_of_lattice(const long lattice) const
     {
-      if (lattice_to_node != nullptr)
+      if (lattice_to_node != nullptr && block_cells == 0)
         return lattice_to_node[lattice];
       int idx[dim];
       lattice_node_coordinates<dim>(n_cells, lattice, idx);
-      return block_slot != nullptr ? node_in_blocks(idx) : node_in_box(idx);
+      return lattice_to_node != nullptr ? node_in_blocks(idx) : node_in_box(idx);
     }
 
     // The node at an index computed by stencil_base (interpolation.h): the lattice index

@@ -322,23 +322,13 @@ namespace mpm
       Real       w[dim][n], dw[dim][n];
       stencil_weights<dim, Shape>(g, x, lp, inv_h, first, w, dw);
       long       lattice_stride[dim], base;
-      const bool inside = stencil_base<dim, n>(g, first, lattice_stride, base);
+      bool       in_lattice = false;
+      const bool inside     = stencil_base<dim, n>(g, first, lattice_stride, base, &in_lattice);
 
       // Runs of neighbouring lanes with the same first stencil node, and the warp's table
-      // of them (filled by each run's head). Through a block table (no base index) a run
-      // is keyed by its first node's lattice index.
-      long key = inside ? base : -1 - lane;
-      if (g.block_slot != nullptr && g.lattice_to_node == nullptr)
-        {
-          bool in = true;
-          key     = 0;
-          for (int d = dim - 1; d >= 0; --d)
-            {
-              in  = in && first[d] >= 0 && first[d] <= g.n_cells[d];
-              key = key * (g.n_cells[d] + 1) + first[d];
-            }
-          key = in ? key : -1 - lane;
-        }
+      // of them (filled by each run's head); through a block table base is the first
+      // node's lattice index, a key all the same.
+      const long key = inside || in_lattice ? base : -1 - lane;
       const long     prev   = __shfl_up_sync(all, key, 1);
       const unsigned heads  = __ballot_sync(all, lane == 0 || prev != key);
       const unsigned upto   = all >> (31 - lane);

@@ -279,12 +279,11 @@ namespace mpm
     GridView<dim, Real> view()
     {
       GridView<dim, Real> v = make_grid_view<dim, Real>(*this);
-      if (!by_blocks)
-        v.block_slot = nullptr;
+      if (by_blocks)
+        v.set_block_table(block_slot.data(), block_cells, node_blocks);
       if (lattice_order)
         {
           v.lattice_to_node = nullptr;
-          v.block_slot      = nullptr;
           for (int d = 0; d < dim; ++d)
             {
               v.box_lower[d] = box_lower[d];
