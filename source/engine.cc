@@ -91,7 +91,12 @@ namespace mpm
           chooser = std::make_unique<NodeBlockChooser<dim>>(own_nodes.n_cells, near.block_cells);
         chooser->choose(blocks_holding_points<dim>(own_nodes.origin, own_nodes.h, own_nodes.n_cells, near.block_cells,
                                                    points.view(), &home_cells));
-        const std::vector<long> &lattice_of_node = chooser->nodes().lattice_of_node;
+        // As on the GPU: the box around the kept blocks where it is compact (a stencil's nodes
+        // are then one index plus offsets, as on every node's grid), else the block table.
+        numbered_by_box = box_of_kept_blocks<dim>(own_nodes.n_cells, near.block_cells, chooser->kept_blocks(), box);
+        if (numbered_by_box)
+          lattice_of_box_node = lattice_of_box_nodes<dim>(own_nodes.n_cells, box);
+        const std::vector<long> &lattice_of_node = lattice_of_kept_node();
         const long               n               = static_cast<long>(lattice_of_node.size());
         own_nodes.allocate_nodes(static_cast<int>(n));
         own_nodes.friction_faces.assign(own_nodes.faces.any_friction() ? n : 0, 0);
@@ -108,14 +113,14 @@ namespace mpm
             }
         own_nodes.cell_volume.assign(n, 0.0); // the cells' sums at their lowest vertex
         own_nodes.cell_pressure_volume.assign(n, 0.0);
-        this->near_material.kept(n);
+        this->near_material.kept(n, numbered_by_box);
       }
 
       void cells_with_mass(typename GridSnapshot<dim>::LatticeCells &out) override
       {
         AssertThrow(this->follows_material(),
                     dealii::ExcMessage("Internal: cells_with_mass() needs Nodes = near material."));
-        out = lattice_cells_with_mass(own_view(), chooser->nodes().lattice_of_node);
+        out = lattice_cells_with_mass(own_view(), lattice_of_kept_node());
       }
 
       unsigned int store(MaterialPoints<dim> &p) override
@@ -146,7 +151,7 @@ namespace mpm
           }
         for (long l = 0; l < n; ++l)
           {
-            const long lattice = this->follows_material() ? chooser->nodes().lattice_of_node[l] : l;
+            const long lattice = this->follows_material() ? lattice_of_kept_node()[l] : l;
             if (lattice < 0) // a kept block's node beyond the lattice
               continue;
             const int node = to.lattice_to_node[lattice];
@@ -198,11 +203,21 @@ namespace mpm
       void set_materials(const std::vector<MaterialParameters<double>> &m) override { materials = m; }
 
     private:
-      // The own nodes' view; near the material, numbered through the chooser's block table.
+      // The own nodes' view; near the material, numbered as the box around them or through
+      // the chooser's block table.
       GridView<dim, double> own_view()
       {
         GridView<dim, double> g = make_grid_view<dim, double>(own_nodes);
-        if (chooser)
+        if (chooser && numbered_by_box)
+          {
+            g.lattice_to_node = nullptr;
+            for (int d = 0; d < dim; ++d)
+              {
+                g.box_lower[d] = box.lower[d];
+                g.box_nodes[d] = box.nodes[d];
+              }
+          }
+        else if (chooser)
           {
             const NodeBlocks<dim> &blocks = chooser->nodes();
             g.set_block_table(blocks.block_slot.data(), blocks.block_cells, blocks.node_blocks);
@@ -215,6 +230,14 @@ namespace mpm
       HostGrid<dim, double>                   own_nodes;
       BackgroundGrid<dim>                    *shared_grid = nullptr;
       std::unique_ptr<NodeBlockChooser<dim>>  chooser; // nodes near the material: their block table
+      bool                                    numbered_by_box = false; // or as the box around them:
+      NodeBox<dim>                            box;
+      std::vector<long>                       lattice_of_box_node;
+
+      const std::vector<long> &lattice_of_kept_node() const
+      {
+        return numbered_by_box ? lattice_of_box_node : chooser->nodes().lattice_of_node;
+      }
       std::vector<MaterialParameters<double>> materials;
       ShapeFunction                           shape;
       CpuBackend                              backend;

@@ -487,7 +487,7 @@ namespace mpm
               << s.engine->most_nodes() << " at most; chosen again " << s.n_node_refreshes
               << " times; the points' distances from the cells they were in checked in " << s.n_home_checks
               << " of " << steps << " steps\n";
-    if (s.engine->follows_material() && parameters.backend == "cuda")
+    if (s.engine->follows_material())
       s.pcout << "  nodes near the material: numbered as the box around the material (no lookup) in "
               << s.engine->node_choices_as_box() << " of " << s.engine->node_choices()
               << " choices (the others through the block table)\n";

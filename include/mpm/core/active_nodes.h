@@ -5,9 +5,10 @@
 // point's cell lies in it or in one of its 3^dim - 1 neighbours, so every cell within B
 // cells (max-norm) of a point's cell is in an active block. The active nodes are those
 // of the node blocks that hold a vertex of an active block's cell, found through a table
-// with one entry per block (GridView::block_slot), so that neither memory nor the work of
-// choosing them grows with the lattice. The node numbering does not change a node's sums: the points scatter in their own order whatever it is,
-// so a step over the active nodes gives the dense grid's results bit for bit as long as
+// with one entry per block (GridView::set_block_table), so that neither memory nor the
+// work of choosing them grows with the lattice. The node numbering does not change a
+// node's sums: the points scatter in their own order whatever it is, so a step over the
+// active nodes gives the dense grid's results bit for bit as long as
 // every point's stencil stays inside them (active_node_margin).
 #pragma once
 
@@ -31,8 +32,7 @@ namespace mpm
     return safe_distance_outside_home_cell(shape) + (block_cells - 1);
   }
 
-  // Nodes kept through a block table (GridView's block_slot, block_cells, node_blocks): node
-  // block c (lattice nodes B c .. B c + B - 1 along each axis) -> slot, -1 where not kept;
+  // Nodes kept through a block table (GridView::set_block_table): node block c (lattice nodes B c .. B c + B - 1 along each axis) -> slot, -1 where not kept;
   // a kept block's nodes are slot B^dim + their offset in it, x fastest.
   template <int dim>
   struct NodeBlocks
@@ -198,15 +198,8 @@ namespace mpm
   private:
     static constexpr int n_neighbours = dim == 2 ? 9 : 27;
     static int           power(const int base, const int e) { return e == 0 ? 1 : base * power(base, e - 1); }
-    static void coordinates(long b, const long along[dim], int c[dim])
-    {
-      for (int d = 0; d < dim; ++d)
-        {
-          c[d] = static_cast<int>(b % along[d]);
-          b /= along[d];
-        }
-    }
-    static void coordinates(long b, const int along[dim], int c[dim])
+    template <typename Count>
+    static void coordinates(long b, const Count along[dim], int c[dim])
     {
       for (int d = 0; d < dim; ++d)
         {
