@@ -120,12 +120,12 @@ namespace mpm
                       "point or touch such a block, chosen again whenever a point has moved far enough to need "
                       "others; cost and memory then follow the material, not the box (the results are the same: "
                       "bit for bit on the CPU, to round-off on the GPU). The grid files then show only the cells "
-                      "with mass, and on one rank deal.II's grid of the whole box is not built. The GPU numbers "
-                      "the kept nodes as the box around them where that box holds at most twice the kept blocks "
-                      "(no lookup per node: as fast as every node of a box that size), else through a table with "
-                      "one entry per block of nodes, as the CPU always does (no array over the whole box, so "
-                      "the box can be far larger than the memory its nodes would take). One rank only for now; "
-                      "on several ranks each rank keeps every node of its part of the grid.");
+                      "with mass, and on one rank deal.II's grid of the whole box is not built. The kept nodes are "
+                      "numbered as the box around them where that box holds at most twice the kept blocks (no "
+                      "lookup per node: as fast as every node of a box that size), else through a table with "
+                      "one entry per block of nodes (no array over the whole box, so the box can be far larger "
+                      "than the memory its nodes would take). One rank only for now; on several ranks each rank "
+                      "keeps every node of its part of the grid.");
     prm.declare_entry("Active block size", "4", Patterns::Integer(1, 64),
                       "Nodes = near material: edge of the blocks, in cells. Every cell within this many cells "
                       "of a point's cell is kept; larger blocks choose the nodes less often but keep more.");
