@@ -99,18 +99,8 @@ namespace mpm
         const std::vector<long> &lattice_of_node = lattice_of_kept_node();
         const long               n               = static_cast<long>(lattice_of_node.size());
         own_nodes.allocate_nodes(static_cast<int>(n));
-        own_nodes.friction_faces.assign(own_nodes.faces.any_friction() ? n : 0, 0);
-        for (long node = 0; node < n; ++node)
-          if (lattice_of_node[node] >= 0) // else beyond the lattice: never reached
-            {
-              int          idx[dim];
-              std::uint8_t friction = 0;
-              own_nodes.lattice_coordinates(lattice_of_node[node], idx);
-              node_boundary_masks<dim>(own_nodes.faces, own_nodes.n_cells, idx, own_nodes.fixed_components[node],
-                                       friction);
-              if (friction != 0)
-                own_nodes.friction_faces[node] = friction;
-            }
+        kept_node_boundary_masks<dim>(own_nodes.faces, own_nodes.n_cells, lattice_of_node, own_nodes.fixed_components,
+                                      own_nodes.friction_faces);
         own_nodes.cell_volume.assign(n, 0.0); // the cells' sums at their lowest vertex
         own_nodes.cell_pressure_volume.assign(n, 0.0);
         this->near_material.kept(n, numbered_by_box);

@@ -1113,26 +1113,13 @@ namespace mpm
       NodeBox<dim>           box;
       const bool             as_box = box_of_kept_blocks<dim>(g.n_cells, block_cells, chooser.kept_blocks(), box);
       const NodeBlocks<dim> &blocks = chooser.nodes();
-      auto lattice_of = [&](const long node) {
-        return as_box ? box.lattice_of(node, g.n_cells) : blocks.lattice_of_node[node];
-      };
-
-      const long n_nodes = as_box ? box.size() : blocks.n_nodes();
+      const std::vector<long> box_lattice = as_box ? lattice_of_box_nodes<dim>(g.n_cells, box) : std::vector<long>();
+      const std::vector<long> &lattice_of_node = as_box ? box_lattice : blocks.lattice_of_node;
+      const long               n_nodes         = static_cast<long>(lattice_of_node.size());
       if (n_nodes > std::numeric_limits<int>::max())
         throw std::invalid_argument("DeviceEngine: more nodes near the points than an int can count");
-      std::vector<std::uint8_t> node_fixed(n_nodes, 0), node_friction(faces.any_friction() ? n_nodes : 0, 0);
-      for (long node = 0; node < n_nodes; ++node)
-        {
-          const long lattice = lattice_of(node);
-          if (lattice < 0) // a kept block's node beyond the lattice: never reached
-            continue;
-          int          idx[dim];
-          std::uint8_t friction = 0;
-          lattice_node_coordinates<dim>(g.n_cells, lattice, idx);
-          node_boundary_masks<dim>(faces, g.n_cells, idx, node_fixed[node], friction);
-          if (friction != 0)
-            node_friction[node] = friction;
-        }
+      std::vector<std::uint8_t> node_fixed, node_friction;
+      kept_node_boundary_masks<dim>(faces, g.n_cells, lattice_of_node, node_fixed, node_friction);
       if (as_box)
         impl->grid.set_box(box.lower, box.nodes, node_fixed, node_friction);
       else

@@ -3,7 +3,10 @@
 // nodes near the material holds no array over the whole lattice.
 #pragma once
 
+#include <mpm/core/views.h>
+
 #include <cstdint>
+#include <vector>
 
 namespace mpm
 {
@@ -40,5 +43,28 @@ namespace mpm
             if (faces.friction[f])
               friction |= std::uint8_t(1u << f);
           }
+  }
+
+  // The masks of kept nodes given by their lattice indices (-1: a node beyond the lattice,
+  // masks 0): fixed gets one entry per node, friction one per node where a face is
+  // frictional, else none (the grids' convention for "no frictional face").
+  template <int dim>
+  void kept_node_boundary_masks(const FaceConditions<dim> &faces, const int n_cells[dim],
+                                const std::vector<long> &lattice_of_node, std::vector<std::uint8_t> &fixed,
+                                std::vector<std::uint8_t> &friction)
+  {
+    const std::size_t n = lattice_of_node.size();
+    fixed.assign(n, 0);
+    friction.assign(faces.any_friction() ? n : 0, 0);
+    for (std::size_t node = 0; node < n; ++node)
+      if (lattice_of_node[node] >= 0)
+        {
+          int          idx[dim];
+          std::uint8_t f = 0;
+          lattice_node_coordinates<dim>(n_cells, lattice_of_node[node], idx);
+          node_boundary_masks<dim>(faces, n_cells, idx, fixed[node], f);
+          if (!friction.empty())
+            friction[node] = f;
+        }
   }
 } // namespace mpm

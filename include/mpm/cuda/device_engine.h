@@ -136,16 +136,17 @@ namespace mpm
       // nodes of blocks of block_cells^dim cells near its points as they are now: the box
       // around those blocks, numbered with no lookup, where it is compact enough
       // (box_of_kept_blocks), else the nodes of those blocks found through a block table
-      // (nodes_of_kept_blocks). Their masks come from the lattice's faces, the pressure
+      // (NodeBlockChooser). Their masks come from the lattice's faces, the pressure
       // averaging's cell sums sit at each cell's lowest node. Every point's home cell becomes
       // its current cell. A pending averaging is applied first. Returns the number of nodes
       // kept.
       int keep_nodes_near_points(int block_cells, const FaceConditions<dim> &faces);
       // Whether the nodes kept last are a box with no lookup.
       bool kept_nodes_are_box() const;
-      // The nodes kept that way: nodal mass and velocity into `nodes` (geometry and block
-      // table set too) and the lattice index of each node (-1: beyond the lattice); returns
-      // the host view of them in the device's numbering.
+      // The nodes kept that way: nodal mass and velocity into `nodes` (and its geometry) and
+      // the lattice index of each node (-1: beyond the lattice); returns the host view of them
+      // in the device's numbering (its block table, if any, the engine's: valid until the
+      // next choice).
       GridView<dim, double> download_kept_nodes(HostGrid<dim, double> &nodes, std::vector<long> &lattice_of_node) const;
 
       // Several ranks: the device time of the ghost exchanges so far, from the end of the

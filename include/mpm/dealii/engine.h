@@ -91,7 +91,7 @@ namespace mpm
     long n_active_nodes() const { return near_material.now; }
     long most_nodes() const { return near_material.most; }
     // Of the choices of nodes near the material so far, those and how many were numbered as
-    // the box around the material with no lookup (the GPU's; the CPU always looks up).
+    // the box around the material (the others through the block table).
     long node_choices() const { return near_material.choices; }
     long node_choices_as_box() const { return near_material.as_box; }
     // Replaces the material table (e.g. when plasticity is switched on).
