@@ -138,10 +138,12 @@ namespace mpm
                           Patterns::Selection("free|no-slip|free-slip|friction"),
                           std::string("Condition on the grid face ") + axis_names[d] + " = " + side +
                             " (boundary id " + std::to_string(2 * d + (side == std::string("max"))) +
-                            "): free, no-slip (all velocity components zero), free-slip (roller: normal "
-                            "component zero) or friction (a rigid wall with Coulomb friction, coefficient "
-                            "Friction coefficient: where material presses on it, normal component zero and "
-                            "the tangential one braked; where material moves away, nothing).");
+                            "): free (points that cross it leave the grid and are removed), no-slip (all "
+                            "velocity components zero), free-slip (roller: normal component zero) or friction "
+                            "(a rigid wall with Coulomb friction, coefficient Friction coefficient: where "
+                            "material presses on it, normal component zero and the tangential one braked; where "
+                            "material moves away, nothing). The three walls also stop the points' centres "
+                            "on the face.");
     prm.declare_entry("Friction coefficient", "0", Patterns::Double(0),
                       "Coulomb friction coefficient mu of every face set to friction: where material presses "
                       "on the wall, the tangential velocity of a wall node is reduced by mu times its normal "

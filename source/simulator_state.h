@@ -537,6 +537,10 @@ namespace mpm
       settings.domain_update      = parameters.domain_update;
       settings.pressure_averaging = parameters.pressure_averaging;
       settings.mass_tolerance     = 1e-12 * m_min; // nodes lighter than that carry no velocity
+      settings.wall_faces         = 0;
+      for (unsigned int id = 0; id < 2 * dim; ++id)
+        if (parameters.boundary[id] != BoundaryType::free)
+          settings.wall_faces |= std::uint8_t(1u << id);
     }
 
     void print_header()

@@ -6,7 +6,8 @@
 //             and base
 //   collapse: V3 geometry (2D, 0.2 m x 0.1 m column against a wall), h = 5 mm, 2x2 ppc,
 //             elastic or Drucker-Prager; no-slip base, rollers on walls, gravity applied at once;
-//             or held, the equilibration's damped steps on the grid
+//             or held, the equilibration's damped steps on the grid; or onto a frictional floor
+//             at the grid's face that stops the points' centres
 //   slide   : 3D elastic block (0.4 x 0.3 x 0.2 m, h = 5 cm, 1,536 points, geostatic stress)
 //             thrown at (2, 1, 0) m/s over a frictional base (mu = 0.3) against a frictional
 //             wall at x max (mu = 0.5) that it reaches after about 0.05 s and rebounds from
@@ -103,19 +104,30 @@ namespace mpm_test
   // held: the equilibration's steps instead (StepSettings::hold_points, the grid keeping its
   // velocities from the second step on, damping 0.8, PIC, the Courant number bounded by the
   // points' domains as in the equilibration).
+  // floor_at_face: the base is the grid's face y = 0, a frictional wall (mu = 0.3) that stops
+  // the points' centres (StepSettings::wall_faces), with FLIP 0.99 and pressure averaging as in
+  // V3's prm (the flow carries centres through this floor where the wall does not stop them,
+  // tests/core/test_wall_friction).
   template <template <int, typename> class Target>
   SceneResult collapse(mpm::HostPoints<2, double> &points, const long n_steps,
                        const mpm::HostPoints<2, double> *initial = nullptr, const bool drucker_prager = false,
-                       const bool held = false, const mpm::ElasticLaw law = mpm::ElasticLaw::jaumann_rate)
+                       const bool held = false, const mpm::ElasticLaw law = mpm::ElasticLaw::jaumann_rate,
+                       const bool floor_at_face = false)
   {
     using namespace mpm;
     const double h = 0.005, rho = 2650, E = 0.84e6, nu = 0.3, g = 9.81;
     const double cfl = held ? std::sqrt(0.25 / 2) : 0.5; // sqrt(l / (dim h)), l = h / 4
     const double length = 0.5, height = 0.15;
+    const int    below  = floor_at_face ? 0 : 2; // cells below the base
     HostGrid<2, double> grid;
-    const double        lower[2] = {-2 * h, -2 * h};
-    const int           cells[2] = {int(std::lround(length / h)) + 4, int(std::lround(height / h)) + 2};
+    const double        lower[2] = {-2 * h, -below * h};
+    const int           cells[2] = {int(std::lround(length / h)) + 4, int(std::lround(height / h)) + below};
     grid.make_dense(lower, h, cells);
+    if (floor_at_face)
+      {
+        grid.friction_faces.assign(grid.mass.size(), 0);
+        grid.friction_coefficient[2] = 0.3;
+      }
     for (long n = 0; n < long(grid.lattice_to_node.size()); ++n)
       {
         int idx[2];
@@ -123,7 +135,9 @@ namespace mpm_test
         std::uint8_t mask = 0;
         if (idx[0] <= 2 || idx[0] >= cells[0] - 2)
           mask |= 1u; // rollers on the walls
-        if (idx[1] <= 2)
+        if (floor_at_face && idx[1] == 0)
+          grid.friction_faces[n] = 1u << 2;
+        else if (idx[1] <= below)
           mask |= 3u; // no-slip base
         grid.fixed_components[n] = mask;
       }
@@ -159,6 +173,13 @@ namespace mpm_test
         s.hold_points   = true;
         s.damping       = 0.8;
         s.flip_fraction = 0;
+      }
+    if (floor_at_face)
+      {
+        s.flip_fraction      = 0.99;
+        s.domain_update      = DomainUpdate::none;
+        s.pressure_averaging = true;
+        s.wall_faces         = 1u << 2;
       }
     Target<2, double> target(grid, points, {m});
     return step_scene<2>(target, s, cfl, h, c, n_steps, law == ElasticLaw::hencky);

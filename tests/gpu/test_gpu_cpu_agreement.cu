@@ -174,6 +174,33 @@ int main()
         report<2>("V3 collapse, DP, GPU sorted every 7", compare_points(cpu, gpu, 0.005), spread, n, true);
       }
       {
+        // V3 with Drucker-Prager onto a frictional floor at the grid's face, which stops the
+        // points' centres that the flow's front carries onto it (stop_at_walls)
+        const long            n = 2500;
+        HostPoints<2, double> cpu, gpu, initial;
+        collapse<CpuTarget>(initial, 0, nullptr, true, false, ElasticLaw::jaumann_rate, true);
+        collapse<CpuTarget>(cpu, n, &initial, true, false, ElasticLaw::jaumann_rate, true);
+        const Difference spread = cpu_reordering_spread(initial, cpu, 0.005, [&](auto &out, const auto *start) {
+          collapse<CpuTarget>(out, n, start, true, false, ElasticLaw::jaumann_rate, true);
+        });
+        collapse<CudaTarget>(gpu, n, &initial, true, false, ElasticLaw::jaumann_rate, true);
+        for (const HostPoints<2, double> *points : {&cpu, &gpu})
+          {
+            int on_floor = 0, removed = 0;
+            for (int i = 0; i < points->size(); ++i)
+              {
+                removed += points->material[i] < 0;
+                on_floor += points->material[i] >= 0 && points->position[1][i] == 0;
+              }
+            std::printf("V3 onto a frictional floor, %s: %d centres stopped on the floor, %d points removed\n",
+                        points == &cpu ? "CPU" : "GPU", on_floor, removed);
+            check(on_floor > 0 && removed == 0, "V3 onto a frictional floor: centres stopped on it, none lost",
+                  on_floor, removed);
+          }
+        report<2>("V3 collapse, DP, frictional floor stopping the points", compare_points(cpu, gpu, 0.005), spread,
+                  n, true);
+      }
+      {
         // P1 with ep2-3De's Drucker-Prager and softening, 2 cells across, 200 steps
         const long            n = 200;
         HostPoints<3, double> cpu, gpu, initial;

@@ -108,6 +108,10 @@ namespace mpm
     // CPDI2q (cpdi.h): each point's corners, as their offsets from the rectangle R_0 s_c
     // (2^dim x dim values, zero at the start) in p.state_variables[corner_state_variable + ...].
     int corner_state_variable = -1;
+    // Bit f set: grid face f (x min, x max, y min, ...) is a rigid wall (no-slip, free-slip or
+    // friction), where a point's centre stops instead of leaving the grid (stopped_at_walls).
+    // 0: every face is open, as the prm's default `free`.
+    std::uint8_t wall_faces = 0;
   };
 
   // Per-step reductions over the points: the next time step needs the largest speed,
@@ -880,9 +884,10 @@ namespace mpm
         if (move)
           for (int d = 0; d < dim; ++d)
             {
-              const Real xn      = x[d] + dt * dx[d];
-              p.position[d][i]   = xn;
-              const Real s_local = (xn - g.origin[d]) / g.h;
+              Real xn      = x[d] + dt * dx[d];
+              Real s_local = (xn - g.origin[d]) / g.h;
+              stop_at_walls(s.wall_faces, d, g.origin[d], g.h, g.n_cells[d], xn, s_local);
+              p.position[d][i] = xn;
               // Also catches NaN, which compares false.
               if (!(s_local >= Real(0) && s_local <= Real(g.n_cells[d])))
                 leaves_grid = true;

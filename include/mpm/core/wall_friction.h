@@ -10,6 +10,7 @@
 // turn velocity noise at the wall into normal impulse one way only, and so into friction:
 // 17% too much braking of a sliding block with MUSL and FLIP, doc/log.md.)
 // A node on several frictional faces (an edge, a corner) meets them one after the other.
+// Every wall, frictional or not, also stops the points' centres (stop_at_walls).
 #pragma once
 
 #include <mpm/core/config.h>
@@ -40,6 +41,29 @@ namespace mpm
     for (int face = 0; face < n_grid_faces<dim>; ++face)
       if (((faces >> face) & 1u) && velocity_into_face(v, face) > Real(0))
         v[face / 2] = Real(0);
+  }
+
+  // A rigid wall (no-slip, free-slip or friction) holds the nodes on it, but a point's centre
+  // moves with every node of its stencil: with GIMP or B-spline weights a point near the wall
+  // still follows the nodes one and two cells inside, so a flow pressing on a wall can carry
+  // centres through it (under a granular flow's front on a frictional floor, doc/theory.md). A
+  // centre that would cross face 2 axis or 2 axis + 1 of `walls` stops on that face instead
+  // of leaving the grid. x: the new coordinate along axis, s_local the same in cell units from
+  // the grid's origin, both in place; NaN passes through (the caller's check catches it).
+  template <typename Real>
+  MPM_HOST_DEVICE inline void stop_at_walls(const std::uint8_t walls, const int axis, const Real origin,
+                                            const Real h, const int n_cells, Real &x, Real &s_local)
+  {
+    if (((walls >> (2 * axis)) & 1u) && s_local < Real(0))
+      {
+        x       = origin;
+        s_local = Real(0);
+      }
+    else if (((walls >> (2 * axis + 1)) & 1u) && s_local > Real(n_cells))
+      {
+        x       = origin + Real(n_cells) * h;
+        s_local = Real(n_cells);
+      }
   }
 
   // v: a node's velocity after the grid update, in place; faces: its friction mask;
