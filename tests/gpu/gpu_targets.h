@@ -57,6 +57,10 @@ namespace mpm_test
       , host_points(p)
     {
       device_grid.upload(g);
+      // The pressure averaging's cell sums where the host grid has them (make_dense), which
+      // DeviceGrid::upload leaves to the owner (DeviceEngine keeps its own).
+      device_grid.cell_volume.upload(g.cell_volume);
+      device_grid.cell_pressure_volume.upload(g.cell_pressure_volume);
       device_points.upload(p);
       device_materials.upload(m);
       order.reset(backend, device_points.size());

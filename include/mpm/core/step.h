@@ -884,14 +884,22 @@ namespace mpm
         if (move)
           for (int d = 0; d < dim; ++d)
             {
-              Real xn      = x[d] + dt * dx[d];
-              Real s_local = (xn - g.origin[d]) / g.h;
-              stop_at_walls(s.wall_faces, d, g.origin[d], g.h, g.n_cells[d], xn, s_local);
-              p.position[d][i] = xn;
+              const Real xn      = x[d] + dt * dx[d];
+              p.position[d][i]   = xn;
+              const Real s_local = (xn - g.origin[d]) / g.h;
               // Also catches NaN, which compares false.
               if (!(s_local >= Real(0) && s_local <= Real(g.n_cells[d])))
                 leaves_grid = true;
             }
+        if (leaves_grid && s.wall_faces != 0) // a wall stops the centre on its face
+          {
+            Real xn[dim];
+            for (int d = 0; d < dim; ++d)
+              xn[d] = p.position[d][i];
+            leaves_grid = !stop_at_walls<dim>(s.wall_faces, g.origin, g.h, g.n_cells, xn);
+            for (int d = 0; d < dim; ++d)
+              p.position[d][i] = xn[d];
+          }
 
         if (deform_points)
           {

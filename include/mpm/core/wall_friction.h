@@ -46,24 +46,28 @@ namespace mpm
   // A rigid wall (no-slip, free-slip or friction) holds the nodes on it, but a point's centre
   // moves with every node of its stencil: with GIMP or B-spline weights a point near the wall
   // still follows the nodes one and two cells inside, so a flow pressing on a wall can carry
-  // centres through it (under a granular flow's front on a frictional floor, doc/theory.md). A
-  // centre that would cross face 2 axis or 2 axis + 1 of `walls` stops on that face instead
-  // of leaving the grid. x: the new coordinate along axis, s_local the same in cell units from
-  // the grid's origin, both in place; NaN passes through (the caller's check catches it).
-  template <typename Real>
-  MPM_HOST_DEVICE inline void stop_at_walls(const std::uint8_t walls, const int axis, const Real origin,
-                                            const Real h, const int n_cells, Real &x, Real &s_local)
+  // centres through it (under a granular flow's front on a frictional floor, doc/theory.md).
+  // For a point whose new position x (in place) is outside the grid: each coordinate beyond a
+  // face of `walls` (bit f: face f, x min, x max, y min, ...) stops on that face. Returns
+  // whether the point is inside the grid now (false where it left through a free face, or x is
+  // not a number). Called only for points outside, so that the step's common path keeps its
+  // code (P1's step: 0.4% slower with the test inline).
+  template <int dim, typename Real>
+  MPM_HOST_DEVICE inline bool stop_at_walls(const std::uint8_t walls, const Real origin[dim], const Real h,
+                                            const int n_cells[dim], Real x[dim])
   {
-    if (((walls >> (2 * axis)) & 1u) && s_local < Real(0))
+    bool inside = true;
+    for (int d = 0; d < dim; ++d)
       {
-        x       = origin;
-        s_local = Real(0);
+        const Real s = (x[d] - origin[d]) / h;
+        if (((walls >> (2 * d)) & 1u) && s < Real(0))
+          x[d] = origin[d];
+        else if (((walls >> (2 * d + 1)) & 1u) && s > Real(n_cells[d]))
+          x[d] = origin[d] + Real(n_cells[d]) * h;
+        else if (!(s >= Real(0) && s <= Real(n_cells[d])))
+          inside = false;
       }
-    else if (((walls >> (2 * axis + 1)) & 1u) && s_local > Real(n_cells))
-      {
-        x       = origin + Real(n_cells) * h;
-        s_local = Real(n_cells);
-      }
+    return inside;
   }
 
   // v: a node's velocity after the grid update, in place; faces: its friction mask;
