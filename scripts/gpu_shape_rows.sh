@@ -55,10 +55,12 @@ row() { echo "== $* ($(date +%T))"; timeout 150 "$@" $P 2>&1 | grep -E "^\| " | 
     row /tmp/new/benchmarks/p1_benchmark --law hencky
     row /tmp/new/benchmarks/p1_benchmark --domain U --law hencky
   fi
-  if [ "${ROWS:-1}" = cpdi ]; then
+  if [ "${ROWS:-1}" = cpdi ]; then # with an old tree, its CPDI rows first
     row /tmp/new/benchmarks/p1_benchmark --domain U
-    row /tmp/new/benchmarks/p1_benchmark --shape cpdi
-    row /tmp/new/benchmarks/p1_benchmark --shape cpdi --transfer tpic
+    for tree in ${OLD:+/tmp/old} /tmp/new; do
+      row $tree/benchmarks/p1_benchmark --shape cpdi
+      row $tree/benchmarks/p1_benchmark --shape cpdi --transfer tpic
+    done
   fi
   if [ "${ROWS:-1}" = 1 ]; then
     row /tmp/new/benchmarks/p1_benchmark --shape linear

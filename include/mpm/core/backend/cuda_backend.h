@@ -265,7 +265,9 @@ namespace mpm
     // is not wholly inside the lattice are runs of one. A warp that is not fully
     // converged (a removed point, the last partial warp) or a block larger than the
     // staging area adds point by point.
-    // CPDI (not a tensor product: corner by corner, cpdi.h) adds point by point.
+    // CPDI (not a tensor product: corner by corner, cpdi.h) adds visit by visit through
+    // add_to_node, so that neighbouring lanes whose corners fall in the same cell sum their
+    // values before the atomic (sorted points share most of them).
     template <int dim, typename Shape, int K, int Kg, typename Real>
     MPM_HOST_DEVICE static void scatter_stencil(const GridView<dim, Real> &g, const Real x[dim], const Real lp[dim],
                                                 Real *const *targets, const StencilContribution<dim, K, Kg, Real> &c)
@@ -276,12 +278,7 @@ namespace mpm
         for_each_stencil_node<dim, Shape>(g, x, lp, [&](const int node, const Real N, const Real *grad) {
           Real values[K];
           c.values(N, grad, values);
-          for (int v = 0; v < K; ++v)
-#if defined(__CUDA_ARCH__)
-            atomicAdd(&targets[v][node], values[v]);
-#else
-            targets[v][node] += values[v];
-#endif
+          add_to_node<K>(targets, node, values);
         });
     }
 
