@@ -109,7 +109,7 @@ namespace mpm
     // (2^dim x dim values, zero at the start) in p.state_variables[corner_state_variable + ...].
     int corner_state_variable = -1;
     // Bit f set: grid face f (x min, x max, y min, ...) is a rigid wall (no-slip, free-slip or
-    // friction), where a point's centre stops instead of leaving the grid (stopped_at_walls).
+    // friction), where a point's centre stops instead of leaving the grid (stop_at_walls, wall_friction.h).
     // 0: every face is open, as the prm's default `free`.
     std::uint8_t wall_faces = 0;
   };
