@@ -3,6 +3,7 @@
   --finite                    every value is finite
   --conserved COL[,COL...]    the columns stay equal to their first value (relative --rtol)
   --removed-at-least N        at least N points were removed (left the grid) by the end
+  --none-removed              no point was removed (left the grid) on any row
   --energy-bounded            the kinetic energy never exceeds the work done by gravity (+1%; the
                               initial elastic energy of the scenes that use it is negligible)
   --at-rest F                 the final kinetic energy is below F times the work done by gravity
@@ -24,6 +25,7 @@ parser.add_argument("--conserved", default="")
 parser.add_argument("--rtol", default="1e-12",
                     help="relative tolerance, or 'auto': n_points * 2.2e-16, the round-off bound of a sum over the points in any order")
 parser.add_argument("--removed-at-least", type=int, default=0)
+parser.add_argument("--none-removed", action="store_true")
 parser.add_argument("--energy-bounded", action="store_true")
 parser.add_argument("--at-rest", type=float)
 args = parser.parse_args()
@@ -65,6 +67,13 @@ if args.removed_at_least:
           f" (the run's own column: {np.max(np.abs(h['mass_balance'])):.3e})")
     if not np.max(np.abs(balance)) <= 1e-12 or not np.max(np.abs(h["mass_balance"])) <= 1e-12:
         print("FAILED: mass lost or made")
+        failed = True
+if args.none_removed:
+    removed = int(np.max(h["n_removed"]))
+    print(f"points removed: {removed} (most on any row), points at the end: {int(h['n_points'][-1])} of "
+          f"{int(h['n_points'][0])}")
+    if removed != 0 or h["n_points"][-1] != h["n_points"][0]:
+        print("FAILED: points were removed")
         failed = True
 if args.energy_bounded:
     excess = np.max(h["kinetic_energy"] - 1.01 * np.maximum(h["work_of_gravity"], 0))
