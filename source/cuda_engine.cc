@@ -112,7 +112,8 @@ namespace mpm
         auto &near = this->near_material;
         if (this->follows_material())
           {
-            const int n_kept = device->keep_nodes_near_points(near.block_cells, faces);
+            const int n_kept = choose_nodes_near_material(
+              near.block_cells, [&]() { return device->keep_nodes_near_points(near.block_cells, faces); });
             near.kept(n_kept, device->kept_nodes_are_box()); // asked after the choice
           }
       }

@@ -89,8 +89,10 @@ namespace mpm
         const auto &near = this->near_material;
         if (!chooser)
           chooser = std::make_unique<NodeBlockChooser<dim>>(own_nodes.n_cells, near.block_cells);
-        chooser->choose(blocks_holding_points<dim>(own_nodes.origin, own_nodes.h, own_nodes.n_cells, near.block_cells,
-                                                   points.view(), &home_cells));
+        choose_nodes_near_material(near.block_cells, [&]() {
+          chooser->choose(blocks_holding_points<dim>(own_nodes.origin, own_nodes.h, own_nodes.n_cells,
+                                                     near.block_cells, points.view(), &home_cells));
+        });
         // As on the GPU: the box around the kept blocks where it is compact (a stencil's nodes
         // are then one index plus offsets, as on every node's grid), else the block table.
         numbered_by_box = box_of_kept_blocks<dim>(own_nodes.n_cells, near.block_cells, chooser->kept_blocks(), box);

@@ -1117,7 +1117,7 @@ namespace mpm
       const std::vector<long> &lattice_of_node = as_box ? box_lattice : blocks.lattice_of_node;
       const long               n_nodes         = static_cast<long>(lattice_of_node.size());
       if (n_nodes > std::numeric_limits<int>::max())
-        throw std::invalid_argument("DeviceEngine: more nodes near the points than an int can count");
+        throw std::length_error("DeviceEngine: more nodes near the points than an int can count");
       std::vector<std::uint8_t> node_fixed, node_friction;
       kept_node_boundary_masks<dim>(faces, g.n_cells, lattice_of_node, node_fixed, node_friction);
       if (as_box)

@@ -17,6 +17,7 @@
 #include "box_scene.h"
 
 #include <cstring>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -250,5 +251,23 @@ int main(int argc, char **argv)
   dealii::Utilities::MPI::MPI_InitFinalize mpi(argc, argv, 1);
   check_dim<2>();
   check_dim<3>();
+  {
+    // Nodes near the material: a choice that would keep more nodes than an int counts ends with
+    // a message naming the parameter (the core throws std::length_error); others pass through.
+    std::string message;
+    try
+      {
+        mpm::choose_nodes_near_material(64, []() -> int { throw std::length_error("too many nodes"); });
+      }
+    catch (const dealii::ExceptionBase &e)
+      {
+        message = e.what();
+      }
+    mpm_test::check(message.find("Grid/Active block size = 64") != std::string::npos &&
+                      message.find("1 to 64") != std::string::npos,
+                    "too many nodes near the material: the error names Grid/Active block size and its range");
+    mpm_test::check(mpm::choose_nodes_near_material(4, []() { return 7; }) == 7,
+                    "a choice within an int's count passes through");
+  }
   return mpm_test::finish("test_one_rank_start");
 }

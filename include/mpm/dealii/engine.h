@@ -18,11 +18,35 @@
 
 #include <limits>
 #include <memory>
+#include <stdexcept>
+#include <string>
 #include <string>
 #include <vector>
 
 namespace mpm
 {
+  // Runs choose(), a choice of the nodes near the points with Grid/Active block size =
+  // block_cells, and returns what it returns. Where the nodes it would keep are more than an
+  // int counts (std::length_error from the core's NodeBlockChooser or the device engine), throws
+  // a deal.II ExcMessage naming that parameter and its allowed values instead.
+  template <typename Choose>
+  auto choose_nodes_near_material(const int block_cells, Choose &&choose) -> decltype(choose())
+  {
+    try
+      {
+        return choose();
+      }
+    catch (const std::length_error &)
+      {
+        AssertThrow(false, dealii::ExcMessage(
+                             "Grid/Active block size = " + std::to_string(block_cells) +
+                             ": the nodes kept near the material (whole blocks of that many nodes per axis around "
+                             "every block of cells holding a point) are more than an int can count. Allowed values "
+                             "are 1 to 64: choose a smaller block size."));
+      }
+    return choose(); // not reached: AssertThrow(false, ...) throws
+  }
+
   template <int dim>
   class Engine
   {
