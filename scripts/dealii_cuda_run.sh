@@ -3,7 +3,7 @@
 # `. /opt/dl/dl-env.sh`: runs the real dealii-mpm with Backend = cuda on the P2 scene
 # (prm/granular_collapse_3d.prm, 512,000 points, 1 s, output every 0.1 s), then a reduced
 # copy of the same prm (Cell size 10 mm and 5 mm) with Backend = cpu and cuda, and the
-# extra programs found in $BIN (test_gpu_*, fp_accuracy, p1_benchmark, p1_benchmark_unrolled).
+# extra programs found in $BIN (test_gpu_*, fp_accuracy, p1_benchmark).
 # Writes logs, histories and the reduced runs' last outputs to $OUT/results.tar.xz. From the repo root:
 #   BIN=build-cuda/dev bash scripts/dealii_cuda_run.sh
 set -u -o pipefail
@@ -101,7 +101,7 @@ grep -hE "GPU-CPU|max" "$OUT"/test_gpu_cpu_agreement.log 2>/dev/null | head -12
 if [ -x "$BIN/fp_accuracy" ]; then
   "$BIN/fp_accuracy" 2>&1 | tee "$OUT/fp_accuracy.log" || status=1
 fi
-for b in p1_benchmark p1_benchmark_unrolled; do
+for b in p1_benchmark; do
   if [ -x "$BIN/$b" ]; then
     echo "== $b" | tee -a "$OUT/bench.log"
     "$BIN/$b" --sizes 160,2560 --steps 200 --profile 2>&1 | tee -a "$OUT/bench.log" || status=1

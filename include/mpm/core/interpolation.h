@@ -2,17 +2,17 @@
 // and gradient grad N_i(x_p). Every P2G and G2P stage goes through this helper.
 //
 // Two forms of the stencil loop, the same nodes in the same order:
-// - the default: one rolled loop over the stencil positions, with run-time indices into
-//   the 1D weights and the lattice bounds checked per node; on the host (not in device
-//   code) the node indices come from a base index plus strides, bounds checked once per
-//   point, with the same weights bit for bit;
-// - -DMPM_UNROLL_STENCIL: loops nested per direction with compile-time bounds, unrolled
-//   on the device, so that the weights stay in registers and every index into them is a
-//   constant, the products of the outer directions' weights formed once per row, and,
-//   where the whole stencil lies inside the lattice, the node's lattice index the point's
-//   base index plus a constant offset (bounds checked once per point).
-// On P1 (H100) the unrolled form raised the P2G kernel from 76 to 121 registers and made
-// it slower (doc/performance.md), so it is not the default.
+// - on the host (HostStencil): one loop over the stencil positions, the node indices from a
+//   base index plus strides, bounds checked once per point;
+// - on the device (and on the host with -DMPM_UNROLL_STENCIL): loops nested per direction
+//   with compile-time bounds, unrolled, so that the weights stay in registers and every
+//   index into them is a constant, the products of the outer directions' weights formed
+//   once per row, and, where the whole stencil lies inside the lattice, the node's lattice
+//   index the point's base index plus a constant offset. The rolled loop that the device
+//   ran until 2026-11-29 read the 1D weights from local memory at run-time indices (20 of
+//   the remap's 32-byte sectors per point on P1); unrolled, P1's step is 4% faster on an
+//   H200 (doc/performance.md). The products come in another order than stencil_weight_at's,
+//   so the device's N and grad N differ from the host's by round-off.
 #pragma once
 
 #include <mpm/core/cpdi.h>
@@ -269,22 +269,6 @@ namespace mpm
     const Real    inv_h = Real(1) / grid.h;
     stencil_weights<dim, Shape>(grid, x, half_length, inv_h, first, w, dw);
 
-#  if !defined(MPM_UNROLL_STENCIL)
-    constexpr int n_stencil = dim == 2 ? n * n : n * n * n;
-    for (int s = 0; s < n_stencil; ++s)
-      {
-        int k[3] = {s % n, (s / n) % n, s / (n * n)};
-        int idx[dim];
-        for (int d = 0; d < dim; ++d)
-          idx[d] = first[d] + k[d];
-        const int node = grid.node(idx);
-        if (node < 0)
-          continue; // outside the lattice: the weight is zero for points inside the grid
-        Real       grad[dim];
-        const Real N = stencil_weight<dim, n>(w, dw, inv_h, k, grad);
-        visit(node, N, grad);
-      }
-#  else
     long       stride[dim], base;
     const bool inside = stencil_base<dim, n>(grid, first, stride, base);
     // Node of stencil position k: by offset inside the lattice, else checked per node
@@ -341,7 +325,6 @@ namespace mpm
               visit(node, w[0][kx] * w[1][ky], grad);
             }
       }
-#  endif
 #endif
       }
   }
