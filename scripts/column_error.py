@@ -65,6 +65,9 @@ if __name__ == "__main__":
     parser.add_argument("--law", choices=["jaumann", "hencky"])
     parser.add_argument("--E", type=float, default=1e4, help="Young's modulus (Pa)")
     parser.add_argument("--max-height-error", type=float, default=None)
+    parser.add_argument("--like", default=None, help="another run's output folder: the error norm must be within "
+                        "--within (relative) of that run's")
+    parser.add_argument("--within", type=float, default=0.05)
     args = parser.parse_args()
     error, p = column_error(args.output_dir, args.rho, args.g, args.l0)
     print(f"V1 column: {len(p['mass'])} points at t = {p['time']:.4g} s, error norm {error:.4e}")
@@ -76,5 +79,13 @@ if __name__ == "__main__":
         print(f"heights against the {args.law} solution (top at {top:.4f} m): error {h_error:.4e}")
         if args.max_height_error is not None and not h_error <= args.max_height_error:
             print(f"FAILED: height error {h_error:.4e} exceeds {args.max_height_error:.4e}")
+            failed = True
+    if args.like:
+        other, _ = column_error(args.like, args.rho, args.g, args.l0)
+        relative = abs(error - other) / other
+        print(f"against {args.like}: error norm {other:.4e}, relative difference {relative:.3g} "
+              f"(at most {args.within:.3g})")
+        if not relative <= args.within:
+            print(f"FAILED: the error norms differ by {relative:.3g} of {other:.4e}")
             failed = True
     sys.exit(1 if failed else 0)

@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """The method study of issue 15: scenes x methods x resolutions, each run's cost and error.
 
-Runs dealii-mpm (the CPU backend, FP64) on each scene at each resolution with each method, and writes
+Runs dealii-mpm (the CPU backend, FP64 unless --precisions says FP32 too) on each scene at each resolution with each method, and writes
 one CSV row per run: scene, method, h, points, steps, wall_s, point_updates_per_s, error, stable,
 precision, backend, machine, date. Draws per scene the Pareto chart (error against wall time,
 log-log, one marker per method, the front of runs no other run beats in both) and, for V1, the
@@ -17,8 +17,9 @@ backend and precision), and draw the charts from all of them (a method added to 
 --backend cuda: the runs through dealii-mpm with Backend = cuda (a build with CUDA, on a GPU machine; TPIC,
 APIC and Hencky run on the CPU only and are refused there; the MMS runs in the core on the CPU whatever this says).
 
---precisions FP64,FP32: also the runs with the step in float, for the scenes that can (the MMS, whose core
-program takes --precision; dealii-mpm is FP64 only, so its scenes run in FP64 whatever this says).
+--precisions FP64,FP32: also the runs with the step in float: V1, V2 and V3 through dealii-mpm with
+Backend/Precision = float (the CPU backend only: with --backend cuda they run in FP64 whatever this says), the
+MMS through its core program's --precision.
 
 --reduced: the coarse levels only (the ctest); --check: assert that every run is stable and its error
 within the scene's bound (not the times), exit 1 if one is not. The bounds are what a usable method
@@ -163,10 +164,12 @@ def run_one(exe, out_root, scene, method, h, overrides, mms_exe=None, backend="c
     other = [f"subsection Material {material}" if x == "@material" else x for x in method_other]
     if backend == "cuda":
         other += ["subsection Backend", "  set Backend = cuda", "end"]
-    out = os.path.join(out_root, f"{scene}-{method}-{h:g}")
+    if precision == "FP32":
+        other += ["subsection Backend", "  set Precision = float", "end"]
+    out = os.path.join(out_root, f"{scene}-{method}-{h:g}" + ("-fp32" if precision == "FP32" else ""))
     done = mpm_runs.run(exe, prm, out, overrides + other, solver + method_solver)
     where = mpm_runs.machine() + (f", {gpu_name()}" if backend == "cuda" else "")
-    row = {"scene": scene, "method": method, "h": h, "precision": "FP64", "backend": backend,
+    row = {"scene": scene, "method": method, "h": h, "precision": precision, "backend": backend,
            "machine": where, "date": mpm_runs.today(), "wall_s": done["wall_s"],
            "steps": done.get("steps", ""), "point_updates_per_s": done.get("point_updates_per_s", "")}
     if done["status"] != "finished":
@@ -268,7 +271,7 @@ def main():
     ap.add_argument("--figures")
     ap.add_argument("--check", action="store_true")
     ap.add_argument("--backend", choices=["cpu", "cuda"], default="cpu")
-    ap.add_argument("--precisions", default="FP64", help="FP64, FP32 or both (FP32: the MMS only)")
+    ap.add_argument("--precisions", default="FP64", help="FP64, FP32 or both (FP32: on the CPU backend)")
     ap.add_argument("--mms-exe", help="the core program mms_study (default: tests/core/mms_study beside --exe)")
     args = ap.parse_args()
     mms_exe = args.mms_exe or os.path.join(os.path.dirname(os.path.abspath(args.exe)), "tests", "core", "mms_study")
@@ -283,7 +286,7 @@ def main():
             for h, overrides in levels:
                 if args.reduced and not any(abs(h - r) < 1e-12 for r in reduced):
                     continue
-                for precision in precisions if scene == "mms" else ["FP64"]:
+                for precision in precisions if scene == "mms" or args.backend == "cpu" else ["FP64"]:
                     row = run_one(args.exe, os.path.abspath(args.out), scene, method, h, overrides, mms_exe,
                                   args.backend, precision)
                     rows.append(row)

@@ -1,17 +1,22 @@
 #include <mpm/core/backend/cpu_backend.h>
 #include <mpm/core/migration.h>
+#include <mpm/core/precision.h>
 #include <mpm/dealii/cuda_engine.h>
 #include <mpm/dealii/engine.h>
 
 #include <deal.II/base/exceptions.h>
 
 #include <algorithm>
+#include <type_traits>
 
 namespace mpm
 {
   namespace
   {
-    template <int dim>
+    // Real: the type the points, the nodes and the step are in (double, or float with
+    // Backend/Precision = float: one rank, every node, built-in materials; the interface stays
+    // in double and the engine converts where points, settings and totals cross it).
+    template <int dim, typename Real = double>
     class CpuEngine : public Engine<dim>
     {
     public:
@@ -20,12 +25,12 @@ namespace mpm
       // by refresh_active_nodes(); their boundary masks come from the lattice's faces.
       CpuEngine(const HostGrid<dim, double> &lattice, const std::vector<MaterialParameters<double>> &materials,
                 const ShapeFunction shape, const int active_block_cells)
-        : materials(materials)
+        : materials(converted<Real>(materials))
         , shape(shape)
       {
         if (active_block_cells == 0)
           {
-            own_nodes = lattice;
+            own_nodes = converted<Real>(lattice);
             own_nodes.allocate_cells();
             return;
           }
@@ -61,7 +66,14 @@ namespace mpm
       void load(const MaterialPoints<dim> &p) override
       {
         auto new_labels = std::make_shared<PointLabels<dim>>();
-        p.copy_to(points, &home_cells, new_labels.get());
+        if constexpr (std::is_same_v<Real, double>)
+          p.copy_to(points, &home_cells, new_labels.get());
+        else
+          {
+            HostPoints<dim, double> given;
+            p.copy_to(given, &home_cells, new_labels.get());
+            convert_points(given, points);
+          }
         labels = std::move(new_labels); // a snapshot being written keeps the old ones
         // New points: the scatter's slabs are built anew for them, as in a new engine (a
         // run resumed from a checkpoint then sums in the order of the run that wrote it).
@@ -72,7 +84,7 @@ namespace mpm
 
       void load(const HostPoints<dim, double> &p, std::shared_ptr<const PointLabels<dim>> new_labels) override
       {
-        points = p;
+        convert_points(p, points);
         home_cells.clear(); // asked for on several ranks (loaded from the handler) and below
         labels = std::move(new_labels);
         backend.forget_grouping();
@@ -112,19 +124,28 @@ namespace mpm
       {
         AssertThrow(this->follows_material(),
                     dealii::ExcMessage("Internal: cells_with_mass() needs Nodes = near material."));
-        out = lattice_cells_with_mass(own_view(), lattice_of_kept_node());
+        if constexpr (std::is_same_v<Real, double>) // nodes near the material: double only
+          out = lattice_cells_with_mass(own_view(), lattice_of_kept_node());
       }
 
       unsigned int store(MaterialPoints<dim> &p) override
       {
-        const unsigned int removed = p.copy_from(points);
+        unsigned int removed;
+        if constexpr (std::is_same_v<Real, double>)
+          removed = p.copy_from(points);
+        else
+          {
+            HostPoints<dim, double> wide;
+            convert_points(points, wide);
+            removed = p.copy_from(wide);
+          }
         load(p); // the handler re-sorted them: take the new order
         return removed;
       }
 
       void snapshot(PointSnapshot<dim> &s) override
       {
-        s.points = points;
+        convert_points(points, s.points);
         s.labels = labels;
       }
 
@@ -165,8 +186,8 @@ namespace mpm
           view.n_points, 0.0,
           [&](const int i) {
             return view.material[i] < 0 ? 0.0 :
-                                          distance_outside_home_cell<dim>(g.origin, g.h, g.n_cells, view.position,
-                                                                          home[i], i);
+                                          double(distance_outside_home_cell<dim>(g.origin, g.h, g.n_cells,
+                                                                                 view.position, home[i], i));
           },
           [](const double a, const double b) { return a > b ? a : b; });
       }
@@ -175,31 +196,54 @@ namespace mpm
       {
         if (shared_grid == nullptr)
           {
-            GridView<dim, double> g = own_view();
+            GridView<dim, Real> g = own_view();
             if (this->follows_material())
               g.cell_sums_at_nodes = true;
             else
               g.lattice_to_node = nullptr; // lattice order: a node's index is its lattice index
-            return explicit_step<dim>(backend, shape, g, points.view(), materials.data(), s, dt, NoGridExchange());
+            return converted<double>(explicit_step<dim>(backend, shape, g, points.view(), materials.data(),
+                                                        converted<Real>(s), static_cast<Real>(dt),
+                                                        NoGridExchange()));
           }
-        GridView<dim, double> g = shared_grid->view();
-        g.cell_volume           = own_nodes.cell_volume.data();
-        g.cell_pressure_volume  = own_nodes.cell_pressure_volume.data();
-        return explicit_step<dim>(backend, shape, g, points.view(), materials.data(), s, dt, shared_grid->exchange());
+        if constexpr (std::is_same_v<Real, double>) // several ranks: double only
+          {
+            GridView<dim, double> g = shared_grid->view();
+            g.cell_volume           = own_nodes.cell_volume.data();
+            g.cell_pressure_volume  = own_nodes.cell_pressure_volume.data();
+            return explicit_step<dim>(backend, shape, g, points.view(), materials.data(), s, dt,
+                                      shared_grid->exchange());
+          }
+        AssertThrow(false, dealii::ExcMessage("Internal: a float engine on several ranks."));
+        return {};
       }
 
-      PointTotals<dim, double> totals() override { return point_totals<dim>(backend, points.view()); }
+      // In double whatever the points are in (float: summed over a widened copy; the history
+      // rows are far apart).
+      PointTotals<dim, double> totals() override
+      {
+        if constexpr (std::is_same_v<Real, double>)
+          return point_totals<dim>(backend, points.view());
+        HostPoints<dim, double> wide;
+        convert_points(points, wide);
+        return point_totals<dim>(backend, wide.view());
+      }
+
+      // Each mass rounded to float is within 2^-24 of its double: so are their sums.
+      double relative_mass_round_off() const override
+      {
+        return std::is_same_v<Real, double> ? Engine<dim>::relative_mass_round_off() : 1e-7;
+      }
 
       long n_points() const override { return points.size(); }
 
-      void set_materials(const std::vector<MaterialParameters<double>> &m) override { materials = m; }
+      void set_materials(const std::vector<MaterialParameters<double>> &m) override { materials = converted<Real>(m); }
 
     private:
       // The own nodes' view; near the material, numbered as the box around them or through
       // the chooser's block table.
-      GridView<dim, double> own_view()
+      GridView<dim, Real> own_view()
       {
-        GridView<dim, double> g = make_grid_view<dim, double>(own_nodes);
+        GridView<dim, Real> g = make_grid_view<dim, Real>(own_nodes);
         if (chooser && numbered_by_box)
           {
             g.lattice_to_node = nullptr;
@@ -219,7 +263,7 @@ namespace mpm
 
       // One rank: the nodes and the cell sums. Several ranks: only the lattice geometry and
       // the cell sums; the nodes are shared_grid's vectors.
-      HostGrid<dim, double>                   own_nodes;
+      HostGrid<dim, Real>                     own_nodes;
       BackgroundGrid<dim>                    *shared_grid = nullptr;
       std::unique_ptr<NodeBlockChooser<dim>>  chooser; // nodes near the material: their block table
       bool                                    numbered_by_box = false; // or as the box around them:
@@ -230,10 +274,10 @@ namespace mpm
       {
         return numbered_by_box ? lattice_of_box_node : chooser->nodes().lattice_of_node;
       }
-      std::vector<MaterialParameters<double>> materials;
+      std::vector<MaterialParameters<Real>>   materials;
       ShapeFunction                           shape;
       CpuBackend                              backend;
-      HostPoints<dim, double>                 points;
+      HostPoints<dim, Real>                   points;
       std::vector<long>                       home_cells; // lattice cell of each point at the last sort
       std::shared_ptr<const PointLabels<dim>> labels;     // id, initial position, in the order of points
     };
@@ -250,9 +294,23 @@ namespace mpm
   template <int dim>
   std::unique_ptr<Engine<dim>> make_engine(const std::string &backend, const HostGrid<dim, double> &lattice,
                                            const std::vector<MaterialParameters<double>> &materials,
-                                           const ShapeFunction shape, const int active_block_cells)
+                                           const ShapeFunction shape, const int active_block_cells,
+                                           const bool single_precision)
   {
     check_backend(backend);
+    if (single_precision)
+      {
+        // Parameters::parse refuses these with the entries' names; a program calling this
+        // directly gets the same reasons.
+        AssertThrow(backend == "cpu" && active_block_cells == 0,
+                    dealii::ExcMessage("Backend/Precision = float runs on the CPU backend (Backend = cpu) with "
+                                       "every node of the grid (Grid/Nodes = all)."));
+        for (const MaterialParameters<double> &m : materials)
+          AssertThrow(m.model != MaterialModel::user_defined,
+                      dealii::ExcMessage("Backend/Precision = float: a material defined outside the library steps "
+                                         "in double only."));
+        return std::make_unique<CpuEngine<dim, float>>(lattice, materials, shape, active_block_cells);
+      }
     if (backend == "cuda") // throws where no device is found
       return make_cuda_engine<dim>(lattice, materials, shape, active_block_cells);
     return std::make_unique<CpuEngine<dim>>(lattice, materials, shape, active_block_cells);
@@ -270,9 +328,11 @@ namespace mpm
   }
 
   template std::unique_ptr<Engine<2>> make_engine(const std::string &, const HostGrid<2, double> &,
-                                                  const std::vector<MaterialParameters<double>> &, ShapeFunction, int);
+                                                  const std::vector<MaterialParameters<double>> &, ShapeFunction, int,
+                                                  bool);
   template std::unique_ptr<Engine<3>> make_engine(const std::string &, const HostGrid<3, double> &,
-                                                  const std::vector<MaterialParameters<double>> &, ShapeFunction, int);
+                                                  const std::vector<MaterialParameters<double>> &, ShapeFunction, int,
+                                                  bool);
   template std::unique_ptr<Engine<2>> make_engine(const std::string &, BackgroundGrid<2> &,
                                                   const std::vector<MaterialParameters<double>> &, ShapeFunction);
   template std::unique_ptr<Engine<3>> make_engine(const std::string &, BackgroundGrid<3> &,

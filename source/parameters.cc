@@ -442,6 +442,12 @@ namespace mpm
                       "that neighbouring threads add into the same nodes and sum before their atomics. 20 "
                       "measured faster than 50 and than every step on P1; 10, 20 and 40 alike on P2 "
                       "(doc/performance.md).");
+    prm.declare_entry("Precision", "double", Patterns::Selection("double|float"),
+                      "The floating-point type of the points, the nodes and the step: double, or float (about half "
+                      "the memory; the results carry float's round-off, about 1e-7 of each value per operation, "
+                      "doc/methods.md). float runs on the CPU backend (Backend = cpu), on one MPI rank, with every "
+                      "node of the grid (Grid/Nodes = all) and the library's materials. Output, checkpoints and the "
+                      "time history are written in double either way.");
     prm.leave_subsection();
 
     prm.enter_subsection("Resources");
@@ -832,9 +838,29 @@ namespace mpm
     prm.leave_subsection();
 
     prm.enter_subsection("Backend");
-    backend       = prm.get("Backend");
-    sort_interval = prm.get_integer("Sort interval");
+    backend          = prm.get("Backend");
+    sort_interval    = prm.get_integer("Sort interval");
+    single_precision = prm.get("Precision") == "float";
     prm.leave_subsection();
+    if (single_precision)
+      {
+        if (backend != "cpu")
+          fail("Backend/Precision", "float runs on the CPU backend only (Backend = cpu), not on '" + backend +
+                                      "'; the allowed values with Backend = " + backend + " are: double.");
+        const bool one_rank = !dealii::Utilities::MPI::job_supports_mpi() ||
+                              dealii::Utilities::MPI::n_mpi_processes(MPI_COMM_WORLD) == 1;
+        if (!one_rank)
+          fail("Backend/Precision", "float runs on one MPI rank only (the ranks exchange their nodal sums in "
+                                    "double); the allowed value on several ranks is: double.");
+        if (active_block_cells > 0)
+          fail("Backend/Precision", "float needs every node of the grid (Grid/Nodes = all); with Grid/Nodes = "
+                                    "near material the allowed value is: double.");
+        for (unsigned int i = 0; i < materials.size(); ++i)
+          if (materials[i].model == MaterialModel::user_defined)
+            fail("Backend/Precision", "float cannot run material '" + material_names[i] + "': its model '" +
+                                        material_models[i] + "' is defined outside the library and steps in "
+                                        "double; the allowed value is: double.");
+      }
 
     if (method_auto)
       {

@@ -305,7 +305,8 @@ namespace mpm
         if (cuda_ready.valid())
           cuda_ready.get();
         s.engine = make_engine<dim>(parameters.backend, lattice_grid<dim>(parameters, parameters.active_block_cells == 0), s.materials,
-                                    parameters.shape_function, parameters.active_block_cells);
+                                    parameters.shape_function, parameters.active_block_cells,
+                                    parameters.single_precision);
         s.engine->set_sort_interval(parameters.sort_interval);
         s.engine->load(host, std::move(labels));
         s.engine_setup_seconds =

@@ -553,7 +553,8 @@ namespace mpm
           n_nodes *= lattice.n_cells[d] + 1;
         }
       pcout << "dealii-mpm: " << dim << "D, " << n_cells << " cells, " << n_nodes << " nodes, " << n_points_initial
-            << " material points, " << n_ranks << " MPI rank(s), backend " << parameters.backend << "\n"
+            << " material points, " << n_ranks << " MPI rank(s), backend " << parameters.backend
+            << (parameters.single_precision ? " in float" : "") << "\n"
             << "  elastic wave speed " << c_el << " m/s, end time " << parameters.end_time << " s, output in '"
             << output->directory() << "'" << std::endl;
       if (engine->follows_material())
@@ -660,7 +661,8 @@ namespace mpm
         {
           if (!engine)
             engine = make_engine<dim>(parameters.backend, lattice_grid<dim>(parameters, parameters.active_block_cells == 0), materials,
-                                      parameters.shape_function, parameters.active_block_cells);
+                                      parameters.shape_function, parameters.active_block_cells,
+                                      parameters.single_precision);
           engine->load(saved.points, saved.labels); // in the saved order: the same sums as before
         }
       engine->set_sort_interval(parameters.sort_interval);
@@ -754,7 +756,8 @@ namespace mpm
 
     // Points are never made or lost but by leaving the grid: the points in the grid and those
     // removed make the initial number exactly, and their masses the initial mass to round-off
-    // (1e-9: the sums' order differs). Throws where either fails: a bug, not a bad input.
+    // (Engine::relative_mass_round_off: 1e-9 in double, the sums' order differs; 1e-7 in float,
+    // each mass rounded once). Throws where either fails: a bug, not a bad input.
     // Returns (removed mass, relative mass balance).
     std::pair<double, double> check_losses(const PointTotals<dim, double> &totals)
     {
@@ -773,12 +776,14 @@ namespace mpm
                                      " material points in the grid and " + std::to_string(removed) +
                                      " removed make " + std::to_string(totals.n_points + removed) + ", not the " +
                                      std::to_string(n_points_initial) + " the run started with."));
-      AssertThrow(std::abs(balance) <= 1e-9,
+      const double round_off = engine->relative_mass_round_off();
+      AssertThrow(std::abs(balance) <= round_off,
                   dealii::ExcMessage("Internal error (loss check)" + when + ": the mass in the grid (" +
                                      dealii::Utilities::to_string(totals.mass) + " kg) and the mass removed (" +
                                      dealii::Utilities::to_string(removed_mass) + " kg) differ from the initial " +
                                      dealii::Utilities::to_string(initial_mass) + " kg by a relative " +
-                                     dealii::Utilities::to_string(balance) + ", beyond round-off (1e-9)."));
+                                     dealii::Utilities::to_string(balance) + ", beyond round-off (" +
+                                     dealii::Utilities::to_string(round_off) + ")."));
       return {removed_mass, balance};
     }
 

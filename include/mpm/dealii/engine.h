@@ -118,6 +118,10 @@ namespace mpm
     // the box around the material (the others through the block table).
     long node_choices() const { return near_material.choices; }
     long node_choices_as_box() const { return near_material.as_box; }
+    // The loss checks' tolerance on the relative mass balance: the round-off of the mass sums
+    // (1e-9 in double, their order differing from the initial sum's); a float engine's masses
+    // are each rounded once.
+    virtual double relative_mass_round_off() const { return 1e-9; }
     // Replaces the material table (e.g. when plasticity is switched on).
     virtual void set_materials(const std::vector<MaterialParameters<double>> &materials) = 0;
 
@@ -151,11 +155,13 @@ namespace mpm
   // One rank: the engine's own nodes on the lattice (lattice_grid: geometry and boundary
   // masks), all of them or, with active_block_cells > 0, those near the material in blocks
   // of that many cells per axis. Throws naming Backend/Backend if the requested backend is
-  // not available.
+  // not available. single_precision (Backend/Precision = float): the points, nodes and step
+  // in float; the CPU backend with every node and built-in materials only.
   template <int dim>
   std::unique_ptr<Engine<dim>> make_engine(const std::string &backend, const HostGrid<dim, double> &lattice,
                                            const std::vector<MaterialParameters<double>> &materials,
-                                           ShapeFunction shape, int active_block_cells = 0);
+                                           ShapeFunction shape, int active_block_cells = 0,
+                                           bool single_precision = false);
 
   // Several ranks: the nodes are the grid's (cpu: its vectors; cuda: the device's copy of
   // the rank's locally relevant nodes, exchanged through the grid's partitioner).

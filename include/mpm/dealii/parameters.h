@@ -138,6 +138,7 @@ namespace mpm
     // Backend
     std::string backend;
     int         sort_interval = 20; // cuda: steps between re-sorts of the points on the device
+    bool        single_precision = false; // Backend/Precision = float: points, nodes and step in float
 
     // The state variables every point of the run carries (user_model.h): their names, the
     // longest list the materials' models declare (where two models name variable k
