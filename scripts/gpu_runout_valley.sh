@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # On the GPU machine (deal.II runtime unpacked, `. /opt/dl/dl-env.sh`): the long-valley run-out
-# (prm/runout_valley_3d.prm: 20.2M points, a lattice of 1.97e9 cells, Grid/Nodes = near material)
+# (prm/runout_valley_3d.prm: 20,000,000 points, a lattice of 1.92e9 cells, Grid/Nodes = near material)
 # with Backend = cuda, to its End time or to LIMIT seconds. Wall time by the shell clock, device
 # memory at its peak over the idle reading (nvidia-smi every 200 ms), the log's summary lines and
 # the history (extent of the material, kinetic energy) into $OUT (or ./out).
