@@ -12,6 +12,7 @@
 #include "../tests/gpu/gpu_targets.h"
 
 #include <mpm/core/point_generation.h>
+#include <mpm/core/precision.h>
 
 #include <cmath>
 #include <cstdio>
@@ -22,52 +23,6 @@
 namespace
 {
   using namespace mpm;
-
-  template <int dim, typename To, typename From>
-  HostPoints<dim, To> convert(const HostPoints<dim, From> &p)
-  {
-    HostPoints<dim, To> q;
-    for_each_point_array<dim>(q, p, [](auto &to, const auto &from) {
-      using T = typename std::decay_t<decltype(to)>::value_type;
-      to.resize(from.size());
-      for (size_t i = 0; i < from.size(); ++i)
-        to[i] = static_cast<T>(from[i]);
-    });
-    return q;
-  }
-
-  template <int dim, typename To, typename From>
-  HostGrid<dim, To> convert(const HostGrid<dim, From> &g)
-  {
-    HostGrid<dim, To> q;
-    To                lo[dim];
-    for (int d = 0; d < dim; ++d)
-      lo[d] = To(g.origin[d]);
-    q.make_dense(lo, To(g.h), g.n_cells);
-    q.fixed_components = g.fixed_components;
-    return q;
-  }
-
-  template <typename Real>
-  MaterialParameters<Real> convert(const MaterialParameters<double> &m)
-  {
-    MaterialParameters<Real> r;
-    r.model                   = m.model;
-    r.plasticity_enabled      = m.plasticity_enabled;
-    r.elastic.youngs_modulus  = Real(m.elastic.youngs_modulus);
-    r.elastic.poissons_ratio  = Real(m.elastic.poissons_ratio);
-    const auto &s             = m.drucker_prager.strength;
-    auto       &t             = r.drucker_prager.strength;
-    t.cohesion                = Real(s.cohesion);
-    t.residual_cohesion       = Real(s.residual_cohesion);
-    t.softening_modulus       = Real(s.softening_modulus);
-    t.friction_angle          = Real(s.friction_angle);
-    t.residual_friction_angle = Real(s.residual_friction_angle);
-    t.friction_softening_strain = Real(s.friction_softening_strain);
-    t.dilatancy_angle         = Real(s.dilatancy_angle);
-    r.drucker_prager.tensile_strength = Real(m.drucker_prager.tensile_strength);
-    return r;
-  }
 
   struct Scene2D
   {
@@ -82,8 +37,9 @@ namespace
   HostPoints<2, double> run(const Scene2D &scene, const double t_end, const double cfl, const double damping,
                             const DomainUpdate domain_update, Gravity &&gravity, long &n_steps)
   {
-    HostGrid<2, Real>   grid   = convert<2, Real>(scene.grid);
-    HostPoints<2, Real> points = convert<2, Real>(scene.points);
+    HostGrid<2, Real>   grid = converted<Real>(scene.grid);
+    HostPoints<2, Real> points;
+    convert_points(scene.points, points);
     StepSettings<2, Real> s;
     s.scheme         = UpdateScheme::musl;
     s.gravity[0]     = 0;
@@ -91,7 +47,7 @@ namespace
     s.flip_fraction  = 1;
     s.domain_update  = domain_update;
     s.mass_tolerance = Real(1e-12 * scene.points.mass[0]);
-    mpm_test::CudaTarget<2, Real> target(grid, points, {convert<Real>(scene.material)});
+    mpm_test::CudaTarget<2, Real> target(grid, points, {converted<Real>(scene.material)});
     auto   gv = target.grid();
     auto   pv = target.points();
     double time = 0, max_speed = 0;
@@ -106,7 +62,9 @@ namespace
         ++n_steps;
       }
     target.finish();
-    return convert<2, double>(points);
+    HostPoints<2, double> result;
+    convert_points(points, result);
+    return result;
   }
 
   void v1()

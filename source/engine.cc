@@ -126,6 +126,8 @@ namespace mpm
                     dealii::ExcMessage("Internal: cells_with_mass() needs Nodes = near material."));
         if constexpr (std::is_same_v<Real, double>) // nodes near the material: double only
           out = lattice_cells_with_mass(own_view(), lattice_of_kept_node());
+        else
+          AssertThrow(false, dealii::ExcMessage("Internal: a float engine with nodes near the material."));
       }
 
       unsigned int store(MaterialPoints<dim> &p) override

@@ -443,9 +443,10 @@ namespace mpm
                       "measured faster than 50 and than every step on P1; 10, 20 and 40 alike on P2 "
                       "(doc/performance.md).");
     prm.declare_entry("Precision", "double", Patterns::Selection("double|float"),
-                      "The floating-point type of the points, the nodes and the step: double, or float (about half "
-                      "the memory; the results carry float's round-off, about 1e-7 of each value per operation, "
-                      "doc/methods.md). float runs on the CPU backend (Backend = cpu), on one MPI rank, with every "
+                      "The floating-point type of the points, the nodes and the step: double, or float (the engine's "
+                      "point and node arrays in half the bytes, though the run's peak memory measured the same on "
+                      "V3 2D, and no faster on the CPU; the results carry float's round-off, about 1e-7 of each "
+                      "value per operation, doc/methods.md). float runs on the CPU backend (Backend = cpu), on one MPI rank, with every "
                       "node of the grid (Grid/Nodes = all) and the library's materials. Output, checkpoints and the "
                       "time history are written in double either way.");
     prm.leave_subsection();

@@ -334,6 +334,9 @@ namespace mpm
         s.balance();
         if (cuda_ready.valid())
           cuda_ready.get();
+        AssertThrow(!parameters.single_precision, // Parameters::parse refuses it; a program setting it too
+                    dealii::ExcMessage("Backend/Precision = float runs on one MPI rank only; the allowed value on "
+                                             "several ranks is: double."));
         s.engine = make_engine<dim>(parameters.backend, *s.grid, s.materials, parameters.shape_function);
         s.engine->set_sort_interval(parameters.sort_interval);
         s.engine->load(*s.points);

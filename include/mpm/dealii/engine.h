@@ -20,7 +20,6 @@
 #include <memory>
 #include <stdexcept>
 #include <string>
-#include <string>
 #include <vector>
 
 namespace mpm
