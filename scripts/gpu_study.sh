@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # On the GPU machine (deal.II runtime unpacked, `. /opt/dl/dl-env.sh`): the method study's scenes through
 # dealii-mpm with Backend = cuda (scripts/study.py --backend cuda), for the methods the device runs.
-#   BIN=dir SCENES=v1,v2 bash scripts/gpu_study.sh   (dir: dealii-mpm, libdealii-mpm.so*.xz, libdeal.ii.so.9.4.1.xz)
-# Writes $OUT/study_cuda_<scenes>.csv and the log.
+#   BIN=dir SCENES=v1,v2 [PRECISIONS=FP64,FP32] bash scripts/gpu_study.sh
+#   (dir: dealii-mpm, libdealii-mpm.so*.xz, libdeal.ii.so.9.4.1.xz)
+# Writes $OUT/study_cuda_<scenes>[_<precisions>].csv and the log.
 set -u -o pipefail
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
 BIN=$(cd "${BIN:?BIN: the folder with the CUDA build of dealii-mpm}" && pwd)
@@ -12,6 +13,8 @@ METHODS=${METHODS:-gimp,linear,cpgimp_det_f,cpgimp_f_ii,cpgimp_u,bspline2,bsplin
 mkdir -p "$OUT"
 . "$ROOT/scripts/gpu_unpack_build.sh"
 prepare_build "$BIN" "$OUT"
+PRECISIONS=${PRECISIONS:-FP64}
 tag=${SCENES//,/_}
+[ "$PRECISIONS" = FP64 ] || tag="${tag}_${PRECISIONS//,/_}"
 python3 "$ROOT/scripts/study.py" --exe "$BIN/dealii-mpm" --backend cuda --out /tmp/study-cuda --scenes "$SCENES" \
-  --methods "$METHODS" --csv "$OUT/study_cuda_$tag.csv" 2>&1 | tee "$OUT/study_cuda_$tag.log"
+  --methods "$METHODS" --precisions "$PRECISIONS" --csv "$OUT/study_cuda_$tag.csv" 2>&1 | tee "$OUT/study_cuda_$tag.log"

@@ -18,8 +18,7 @@ backend and precision), and draw the charts from all of them (a method added to 
 APIC and Hencky run on the CPU only and are refused there; the MMS runs in the core on the CPU whatever this says).
 
 --precisions FP64,FP32: also the runs with the step in float: V1, V2 and V3 through dealii-mpm with
-Backend/Precision = float (the CPU backend only: with --backend cuda they run in FP64 whatever this says), the
-MMS through its core program's --precision.
+Backend/Precision = float (on the --backend given), the MMS through its core program's --precision (CPU).
 
 --reduced: the coarse levels only (the ctest); --check: assert that every run is stable and its error
 within the scene's bound (not the times), exit 1 if one is not. The bounds are what a usable method
@@ -271,7 +270,7 @@ def main():
     ap.add_argument("--figures")
     ap.add_argument("--check", action="store_true")
     ap.add_argument("--backend", choices=["cpu", "cuda"], default="cpu")
-    ap.add_argument("--precisions", default="FP64", help="FP64, FP32 or both (FP32: on the CPU backend)")
+    ap.add_argument("--precisions", default="FP64", help="FP64, FP32 or both")
     ap.add_argument("--mms-exe", help="the core program mms_study (default: tests/core/mms_study beside --exe)")
     args = ap.parse_args()
     mms_exe = args.mms_exe or os.path.join(os.path.dirname(os.path.abspath(args.exe)), "tests", "core", "mms_study")
@@ -286,7 +285,7 @@ def main():
             for h, overrides in levels:
                 if args.reduced and not any(abs(h - r) < 1e-12 for r in reduced):
                     continue
-                for precision in precisions if scene == "mms" or args.backend == "cpu" else ["FP64"]:
+                for precision in precisions:
                     row = run_one(args.exe, os.path.abspath(args.out), scene, method, h, overrides, mms_exe,
                                   args.backend, precision)
                     rows.append(row)

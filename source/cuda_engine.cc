@@ -19,6 +19,7 @@
 #  include <chrono>
 #  include <iostream>
 #  include <map>
+#  include <type_traits>
 #endif
 
 namespace mpm
@@ -79,7 +80,9 @@ namespace mpm
       }
     };
 
-    template <int dim>
+    // Real: the type the device keeps the points and nodes in (float: Backend/Precision =
+    // float, one rank with every node); the interface stays in double.
+    template <int dim, typename Real = double>
     class CudaEngine : public Engine<dim>
     {
     public:
@@ -104,7 +107,7 @@ namespace mpm
             for (int d = 0; d < dim; ++d)
               view.box_nodes[d] = 0;
           }
-        device = std::make_unique<cuda::DeviceEngine<dim>>(view, materials, shape, nullptr);
+        device = std::make_unique<cuda::DeviceEngine<dim, Real>>(view, materials, shape, nullptr);
       }
 
       void refresh_active_nodes() override
@@ -300,6 +303,12 @@ namespace mpm
 
       PointTotals<dim, double> totals() override { return device->totals(); }
 
+      // Each mass rounded to float is within 2^-24 of its double: so are their sums (in double).
+      double relative_mass_round_off() const override
+      {
+        return std::is_same<Real, double>::value ? Engine<dim>::relative_mass_round_off() : 1e-7;
+      }
+
       double max_distance_outside_home_cells() override
       {
         AssertThrow(shared_grid != nullptr || this->follows_material(),
@@ -331,7 +340,7 @@ namespace mpm
       std::shared_ptr<const dealii::Utilities::MPI::Partitioner> built_for;
       double exchange_seconds_before = 0, exchange_host_seconds_before = 0; // on devices since rebuilt
       std::unique_ptr<GridExchange<dim>>      exchange; // declared before device: outlives it
-      std::unique_ptr<cuda::DeviceEngine<dim>> device;
+      std::unique_ptr<cuda::DeviceEngine<dim, Real>> device;
       HostPoints<dim, double>                 host;       // staging for load/store from the handler only
       std::vector<long>                       home_cells; // several ranks: lattice cell of each point at load
       std::shared_ptr<const PointLabels<dim>> labels;     // id, initial position, in the uploaded order
@@ -360,7 +369,7 @@ namespace mpm
         device.reset();
         exchange  = std::make_unique<GridExchange<dim>>(*shared_grid);
         built_for = shared_grid->partitioner;
-        device    = std::make_unique<cuda::DeviceEngine<dim>>(shared_grid->view(), materials, shape, exchange.get());
+        device    = std::make_unique<cuda::DeviceEngine<dim, Real>>(shared_grid->view(), materials, shape, exchange.get());
         if (sort_interval >= 0)
           device->set_sort_interval(sort_interval);
         long n_lattice_cells = 1;
@@ -462,15 +471,23 @@ namespace mpm
   template <int dim>
   std::unique_ptr<Engine<dim>> make_cuda_engine(const HostGrid<dim, double> &lattice,
                                                 const std::vector<MaterialParameters<double>> &materials,
-                                                const ShapeFunction shape, const int active_block_cells)
+                                                const ShapeFunction shape, const int active_block_cells,
+                                                const bool single_precision)
   {
 #ifdef MPM_CUDA_ENGINE
     check_models(materials);
     check_device(MPI_COMM_SELF);
     cuda::use_device_of_local_rank(0);
     std::cout << "  CUDA device: " << cuda::device_description() << std::endl; // one rank
+    if (single_precision)
+      {
+        AssertThrow(active_block_cells == 0, // Parameters::parse refuses it with the entry's name
+                    dealii::ExcMessage("Backend/Precision = float needs every node of the grid (Grid/Nodes = all)."));
+        return std::make_unique<CudaEngine<dim, float>>(lattice, materials, shape, active_block_cells);
+      }
     return std::make_unique<CudaEngine<dim>>(lattice, materials, shape, active_block_cells);
 #else
+    (void)single_precision;
     (void)active_block_cells;
     (void)lattice;
     (void)materials;
@@ -520,10 +537,10 @@ namespace mpm
 
   template std::unique_ptr<Engine<2>> make_cuda_engine(const HostGrid<2, double> &,
                                                        const std::vector<MaterialParameters<double>> &, ShapeFunction,
-                                                       int);
+                                                       int, bool);
   template std::unique_ptr<Engine<3>> make_cuda_engine(const HostGrid<3, double> &,
                                                        const std::vector<MaterialParameters<double>> &, ShapeFunction,
-                                                       int);
+                                                       int, bool);
   template std::unique_ptr<Engine<2>> make_cuda_engine(BackgroundGrid<2> &,
                                                        const std::vector<MaterialParameters<double>> &, ShapeFunction);
   template std::unique_ptr<Engine<3>> make_cuda_engine(BackgroundGrid<3> &,

@@ -219,15 +219,10 @@ namespace mpm
         return {};
       }
 
-      // In double whatever the points are in (float: summed over a widened copy; the history
-      // rows are far apart).
+      // Summed in double whatever the points are in.
       PointTotals<dim, double> totals() override
       {
-        if constexpr (std::is_same_v<Real, double>)
-          return point_totals<dim>(backend, points.view());
-        HostPoints<dim, double> wide;
-        convert_points(points, wide);
-        return point_totals<dim>(backend, wide.view());
+        return point_totals<dim, Real, CpuBackend, double>(backend, points.view());
       }
 
       // Each mass rounded to float is within 2^-24 of its double: so are their sums.
@@ -304,17 +299,17 @@ namespace mpm
       {
         // Parameters::parse refuses these with the entries' names; a program calling this
         // directly gets the same reasons.
-        AssertThrow(backend == "cpu" && active_block_cells == 0,
-                    dealii::ExcMessage("Backend/Precision = float runs on the CPU backend (Backend = cpu) with "
-                                       "every node of the grid (Grid/Nodes = all)."));
+        AssertThrow(active_block_cells == 0,
+                    dealii::ExcMessage("Backend/Precision = float needs every node of the grid (Grid/Nodes = all)."));
         for (const MaterialParameters<double> &m : materials)
           AssertThrow(m.model != MaterialModel::user_defined,
                       dealii::ExcMessage("Backend/Precision = float: a material defined outside the library steps "
                                          "in double only."));
-        return std::make_unique<CpuEngine<dim, float>>(lattice, materials, shape, active_block_cells);
+        if (backend == "cpu")
+          return std::make_unique<CpuEngine<dim, float>>(lattice, materials, shape, active_block_cells);
       }
     if (backend == "cuda") // throws where no device is found
-      return make_cuda_engine<dim>(lattice, materials, shape, active_block_cells);
+      return make_cuda_engine<dim>(lattice, materials, shape, active_block_cells, single_precision);
     return std::make_unique<CpuEngine<dim>>(lattice, materials, shape, active_block_cells);
   }
 

@@ -7,6 +7,7 @@
 #include <mpm/core/active_nodes.h>
 #include <mpm/core/exchange_overlap.h>
 #include <mpm/core/migration.h>
+#include <mpm/core/precision.h>
 #include <mpm/cuda/device_engine.h>
 
 #include <cub/device/device_select.cuh>
@@ -409,21 +410,30 @@ namespace mpm
         CudaBackend     *backend  = nullptr;
         Staging<int>    *nodes    = nullptr;
         Staging<long>   *cells    = nullptr;
+        // The exchange is in double: a float engine has none (one rank).
         template <typename Real>
         void sum_nodal(Real *const *arrays, const int count) const
         {
-          static_assert(std::is_same<Real, double>::value, "the engine runs in double");
-          if (exchange != nullptr)
-            nodes->exchange(*backend, arrays, count,
-                            [this](double *values, const int c) { exchange->sum_nodal(values, c); });
+          if constexpr (std::is_same<Real, double>::value)
+            {
+              if (exchange != nullptr)
+                nodes->exchange(*backend, arrays, count,
+                                [this](double *values, const int c) { exchange->sum_nodal(values, c); });
+            }
+          else if (exchange != nullptr)
+            throw std::logic_error("DeviceEngine: the nodal exchange runs in double only");
         }
         template <typename Real>
         void sum_cells(Real *const *arrays, const int count) const
         {
-          static_assert(std::is_same<Real, double>::value, "the engine runs in double");
-          if (exchange != nullptr)
-            cells->exchange(*backend, arrays, count,
-                            [this](double *values, const int c) { exchange->sum_cells(values, c); });
+          if constexpr (std::is_same<Real, double>::value)
+            {
+              if (exchange != nullptr)
+                cells->exchange(*backend, arrays, count,
+                                [this](double *values, const int c) { exchange->sum_cells(values, c); });
+            }
+          else if (exchange != nullptr)
+            throw std::logic_error("DeviceEngine: the nodal exchange runs in double only");
         }
 
         // The overlap (explicit_step's pass_then_sum): the points in the device's order whose
@@ -434,11 +444,15 @@ namespace mpm
         template <typename Real>
         void begin_sum(const ExchangedEntries entries, Real *const *arrays, const int count) const
         {
-          static_assert(std::is_same<Real, double>::value, "the engine runs in double");
-          if (entries == ExchangedEntries::nodes)
-            nodes->begin_overlapped(*backend, arrays, count);
+          if constexpr (std::is_same<Real, double>::value)
+            {
+              if (entries == ExchangedEntries::nodes)
+                nodes->begin_overlapped(*backend, arrays, count);
+              else
+                cells->begin_overlapped(*backend, arrays, count);
+            }
           else
-            cells->begin_overlapped(*backend, arrays, count);
+            throw std::logic_error("DeviceEngine: the nodal exchange runs in double only");
         }
         void end_sum(const ExchangedEntries entries) const
         {
@@ -457,31 +471,31 @@ namespace mpm
       struct HasCellArrays<G, decltype((void)std::declval<G &>().cell_volume, void())> : std::true_type
       {};
 
-      template <typename G>
-      void set_cell_arrays(G &g, double *volume, double *pressure_volume, std::true_type)
+      template <typename G, typename Real>
+      void set_cell_arrays(G &g, Real *volume, Real *pressure_volume, std::true_type)
       {
         g.cell_volume          = volume;
         g.cell_pressure_volume = pressure_volume;
       }
-      template <typename G>
-      void set_cell_arrays(G &, double *, double *, std::false_type)
+      template <typename G, typename Real>
+      void set_cell_arrays(G &, Real *, Real *, std::false_type)
       {}
     } // namespace
 
-    template <int dim>
-    struct DeviceEngine<dim>::Impl
+    template <int dim, typename Real>
+    struct DeviceEngine<dim, Real>::Impl
     {
       CudaBackend                  backend;
-      DeviceGrid<dim, double>      grid;
-      DevicePoints<dim, double>    points;
-      PointOrder<dim, double>      order; // points sorted by stencil every sort_interval steps
+      DeviceGrid<dim, Real>        grid;
+      DevicePoints<dim, Real>      points;
+      PointOrder<dim, Real>        order; // points sorted by stencil every sort_interval steps
       long                         steps_since_upload = 0;
       // MPM_CUDA_KERNEL_TIMES=N: per-launch times of steps N..N+4 after an upload, printed
       // once (what the profiler would say, without one; doc/performance.md).
       long                         timed_from = -1, n_timed_steps = 0;
       std::vector<double>          launch_ms;
-      DeviceMaterials<double>      materials;
-      DeviceArray<double>          cell_volume, cell_pressure_volume;
+      DeviceMaterials<Real>        materials;
+      DeviceArray<Real>            cell_volume, cell_pressure_volume;
       long                         n_lattice_cells = 1;
       ShapeFunction                shape;
       // A material asks for Hencky's law: the step runs the kernels that hold it.
@@ -525,11 +539,11 @@ namespace mpm
       DeviceArray<std::uint8_t>    block_marks; // blocks holding a point's cell (keep_nodes_near_points)
 
       // The device grid's view, with the averaging's cell arrays where they exist.
-      GridView<dim, double> view()
+      GridView<dim, Real> view()
       {
-        GridView<dim, double> g = grid.view();
+        GridView<dim, Real> g = grid.view();
         if (cell_volume.size() > 0)
-          set_cell_arrays(g, cell_volume.data(), cell_pressure_volume.data(), HasCellArrays<GridView<dim, double>>());
+          set_cell_arrays(g, cell_volume.data(), cell_pressure_volume.data(), HasCellArrays<GridView<dim, Real>>());
         g.cell_sums_at_nodes = cell_sums_at_nodes;
         return g;
       }
@@ -566,11 +580,13 @@ namespace mpm
       }
     };
 
-    template <int dim>
-    DeviceEngine<dim>::DeviceEngine(const GridView<dim, double> &g,
+    template <int dim, typename Real>
+    DeviceEngine<dim, Real>::DeviceEngine(const GridView<dim, double> &g,
                                     const std::vector<MaterialParameters<double>> &materials, const ShapeFunction shape,
                                     NodalExchange *exchange)
     {
+      if (!std::is_same<Real, double>::value && exchange != nullptr)
+        throw std::logic_error("DeviceEngine: the float engine runs on one rank (the exchange is in double)");
       std::string why;
       if (device_count(&why) == 0)
         throw std::runtime_error("no CUDA device: " + why);
@@ -634,7 +650,7 @@ namespace mpm
             if (const int node = lattice_nodes[node_offset + b]; node >= 0)
               host.friction_faces[b] = g.friction_faces[node];
         }
-      impl->grid.upload(host);
+      impl->grid.upload(converted<Real>(host));
       int slab_lower[dim], slab_nodes[dim]; // no lookup: the slab's layers, lattice order
       for (int d = 0; d < dim; ++d)
         {
@@ -642,7 +658,7 @@ namespace mpm
           slab_nodes[d] = d < dim - 1 ? g.n_cells[d] + 1 : static_cast<int>(n_slab / layer);
         }
       impl->grid.set_box(slab_lower, slab_nodes);
-      impl->materials.upload(materials);
+      impl->materials.upload(converted<Real>(materials));
       impl->hencky = uses_hencky(materials);
       impl->exchange = ExchangeAdapter{exchange, &impl->backend, &impl->exchanged_nodes, &impl->exchanged_cells};
       if (exchange != nullptr)
@@ -667,13 +683,20 @@ namespace mpm
         }
     }
 
-    template <int dim>
-    DeviceEngine<dim>::~DeviceEngine() = default;
+    template <int dim, typename Real>
+    DeviceEngine<dim, Real>::~DeviceEngine() = default;
 
-    template <int dim>
-    void DeviceEngine<dim>::upload_points(const HostPoints<dim, double> &p)
+    template <int dim, typename Real>
+    void DeviceEngine<dim, Real>::upload_points(const HostPoints<dim, double> &p)
     {
-      impl->points.upload(p);
+      if constexpr (std::is_same<Real, double>::value)
+        impl->points.upload(p);
+      else
+        {
+          HostPoints<dim, Real> rounded;
+          convert_points<Real>(p, rounded);
+          impl->points.upload(rounded);
+        }
       impl->order.reset(impl->backend, impl->points.size());
       impl->home_cells.resize(0); // set_home_cells gives those of these points
       impl->home_by_slot_stale = true;
@@ -683,40 +706,47 @@ namespace mpm
       impl->averaging_pending  = false; // the host's stresses are final
     }
 
-    template <int dim>
-    void DeviceEngine<dim>::download_points(HostPoints<dim, double> &p) const
+    template <int dim, typename Real>
+    void DeviceEngine<dim, Real>::download_points(HostPoints<dim, double> &p) const
     {
       impl->finish_pending_averaging();
       impl->backend.synchronize();
-      impl->order.download_in_reference_order(impl->backend, impl->points, p);
+      if constexpr (std::is_same<Real, double>::value)
+        impl->order.download_in_reference_order(impl->backend, impl->points, p);
+      else
+        {
+          HostPoints<dim, Real> rounded;
+          impl->order.download_in_reference_order(impl->backend, impl->points, rounded);
+          convert_points<double>(rounded, p);
+        }
     }
 
-    template <int dim>
-    void DeviceEngine<dim>::set_sort_interval(const int steps)
+    template <int dim, typename Real>
+    void DeviceEngine<dim, Real>::set_sort_interval(const int steps)
     {
       if (steps < 0)
         throw std::invalid_argument("DeviceEngine::set_sort_interval: the interval must be >= 0");
       sort_interval = steps;
     }
 
-    template <int dim>
-    void DeviceEngine<dim>::download_nodal(const GridView<dim, double> &g) const
+    template <int dim, typename Real>
+    void DeviceEngine<dim, Real>::download_nodal(const GridView<dim, double> &g) const
     {
       impl->backend.synchronize();
-      const DeviceGrid<dim, double> &dg = impl->grid;
+      const DeviceGrid<dim, Real> &dg = impl->grid;
       for (int d = 0; d < dim; ++d)
         if (g.n_cells[d] != dg.n_cells[d])
           throw std::invalid_argument("DeviceEngine::download_nodal: the host grid has another lattice");
       // Device node b is the host's node of its lattice index (absent from the host: not
       // written).
-      std::vector<double> staging(dg.mass.size());
+      std::vector<Real>   staging(dg.mass.size());
       std::vector<int>    host_node(staging.size());
       for (size_t b = 0; b < host_node.size(); ++b)
         {
           const long lattice = impl->lattice_of_device_node(static_cast<long>(b));
           host_node[b]       = lattice < 0 ? -1 : g.node_of_lattice(lattice);
         }
-      auto download = [&](double *to, const DeviceArray<double> &from) {
+      auto download = [&](double *to, const DeviceArray<Real> &from) {
         from.download(staging);
         for (size_t b = 0; b < staging.size(); ++b)
           if (host_node[b] >= 0)
@@ -729,10 +759,13 @@ namespace mpm
         download(g.velocity[d], dg.velocity[d]);
     }
 
-    template <int dim>
-    StepReduction<double> DeviceEngine<dim>::step(const StepSettings<dim, double> &s, const double dt)
+    template <int dim, typename Real>
+    StepReduction<double> DeviceEngine<dim, Real>::step(const StepSettings<dim, double> &settings_in_double,
+                                                        const double dt_in_double)
     {
-      GridView<dim, double> g = impl->grid.view();
+      const StepSettings<dim, Real> s  = converted<Real>(settings_in_double);
+      const Real                    dt = static_cast<Real>(dt_in_double);
+      GridView<dim, Real>           g  = impl->grid.view();
       if (sort_interval > 0 && impl->steps_since_upload % sort_interval == 0)
         {
           // The overlap's split needs every point's home cell.
@@ -760,7 +793,7 @@ namespace mpm
       ++impl->steps_since_upload;
       if (s.pressure_averaging)
         {
-          if (!HasCellArrays<GridView<dim, double>>::value)
+          if (!HasCellArrays<GridView<dim, Real>>::value)
             throw std::runtime_error("pressure averaging is not available in this build of the CUDA engine");
           if (impl->cell_volume.size() == 0)
             {
@@ -776,7 +809,7 @@ namespace mpm
         throw std::invalid_argument("DeviceEngine::step: the affine transfers need the points uploaded with their "
                                     "affine matrices (dim x dim state variables)");
       const bool all_physics = impl->hencky || s.affine_state_variable >= 0;
-      const StepReduction<double> r =
+      const StepReduction<Real> r =
         all_physics ? explicit_step<dim, DevicePhysics::all>(impl->backend, impl->shape, g, impl->points.view(),
                                                               impl->materials.data(), s, dt, impl->exchange,
                                                               &impl->averaging_pending) :
@@ -802,25 +835,26 @@ namespace mpm
               impl->backend.enable_kernel_timing(false);
             }
         }
-      return r;
+      return converted<double>(r);
     }
 
-    template <int dim>
-    PointTotals<dim, double> DeviceEngine<dim>::totals()
+    template <int dim, typename Real>
+    PointTotals<dim, double> DeviceEngine<dim, Real>::totals()
     {
-      return point_totals<dim>(impl->backend, impl->points.view());
+      // Summed in double whatever Real is (the loss checks compare the mass with its first sum).
+      return point_totals<dim, Real, CudaBackend, double>(impl->backend, impl->points.view());
     }
 
-    template <int dim>
-    void DeviceEngine<dim>::set_materials(const std::vector<MaterialParameters<double>> &materials)
+    template <int dim, typename Real>
+    void DeviceEngine<dim, Real>::set_materials(const std::vector<MaterialParameters<double>> &materials)
     {
       impl->backend.synchronize(); // the table may be in use by a launch in flight
-      impl->materials.upload(materials);
+      impl->materials.upload(converted<Real>(materials));
       impl->hencky = uses_hencky(materials);
     }
 
-    template <int dim>
-    void DeviceEngine<dim>::upload_labels(const std::vector<std::vector<double>> &labels)
+    template <int dim, typename Real>
+    void DeviceEngine<dim, Real>::upload_labels(const std::vector<std::vector<double>> &labels)
     {
       impl->labels.resize(labels.size());
       for (std::size_t k = 0; k < labels.size(); ++k)
@@ -831,8 +865,8 @@ namespace mpm
         }
     }
 
-    template <int dim>
-    void DeviceEngine<dim>::download_labels(std::vector<std::vector<double>> &labels) const
+    template <int dim, typename Real>
+    void DeviceEngine<dim, Real>::download_labels(std::vector<std::vector<double>> &labels) const
     {
       impl->backend.synchronize();
       labels.resize(impl->labels.size());
@@ -840,8 +874,8 @@ namespace mpm
         impl->labels[k].download(labels[k]);
     }
 
-    template <int dim>
-    void DeviceEngine<dim>::set_home_cells(const std::vector<long> &home_cells)
+    template <int dim, typename Real>
+    void DeviceEngine<dim, Real>::set_home_cells(const std::vector<long> &home_cells)
     {
       if (static_cast<int>(home_cells.size()) != impl->points.size())
         throw std::invalid_argument("DeviceEngine::set_home_cells: one home cell per uploaded point is needed");
@@ -850,8 +884,8 @@ namespace mpm
       impl->exchange.first_points = -1; // the split follows the home cells at the next sort
     }
 
-    template <int dim>
-    double DeviceEngine<dim>::max_distance_outside_home_cells()
+    template <int dim, typename Real>
+    double DeviceEngine<dim, Real>::max_distance_outside_home_cells()
     {
       const int n = impl->points.size();
       if (static_cast<int>(impl->home_cells.size()) != n)
@@ -868,335 +902,357 @@ namespace mpm
             impl->backend.for_each_node(n, [=] MPM_HOST_DEVICE(const int i) { to[i] = home[original[i]]; });
           impl->home_by_slot_stale = false;
         }
-      const PointsView<dim, double> p    = impl->points.view();
-      const GridView<dim, double>   g    = impl->grid.view();
-      const long                   *home = impl->home_by_slot.data();
+      const PointsView<dim, Real> p    = impl->points.view();
+      const GridView<dim, Real>   g    = impl->grid.view();
+      const long                 *home = impl->home_by_slot.data();
       return impl->backend.reduce_points(
         n, 0.0,
         [=] MPM_HOST_DEVICE(const int i) {
-          return p.material[i] < 0 ? 0.0 :
-                                     distance_outside_home_cell<dim>(g.origin, g.h, g.n_cells, p.position, home[i], i);
+          const Real out = distance_outside_home_cell<dim>(g.origin, g.h, g.n_cells, p.position, home[i], i);
+          return p.material[i] < 0 ? 0.0 : static_cast<double>(out);
         },
         [] MPM_HOST_DEVICE(const double a, const double b) { return a > b ? a : b; });
     }
 
-    template <int dim>
-    void DeviceEngine<dim>::set_owned_cells(const std::vector<std::uint8_t> &owned)
+    template <int dim, typename Real>
+    void DeviceEngine<dim, Real>::set_owned_cells(const std::vector<std::uint8_t> &owned)
     {
       if (static_cast<long>(owned.size()) != impl->n_lattice_cells)
         throw std::invalid_argument("DeviceEngine::set_owned_cells: one entry per lattice cell is needed");
       impl->owned_cells.upload(owned);
     }
 
-    template <int dim>
-    int DeviceEngine<dim>::take_leaving_points(HostPoints<dim, double>          &leaving,
+    template <int dim, typename Real>
+    int DeviceEngine<dim, Real>::take_leaving_points(HostPoints<dim, double>          &leaving,
                                                std::vector<std::vector<double>> &leaving_labels)
     {
-      if (static_cast<long>(impl->owned_cells.size()) != impl->n_lattice_cells)
-        throw std::logic_error("DeviceEngine::take_leaving_points: the owned cells are not known");
-      if (impl->averaging_pending)
+      if constexpr (!std::is_same<Real, double>::value)
+        throw std::logic_error("DeviceEngine::take_leaving_points: in double only");
+      else
         {
-          stages::finish_pressure_averaging(impl->backend, impl->view(), impl->points.view());
-          impl->averaging_pending = false;
-        }
-      const int n = impl->points.size();
-      // Per slot: stays, leaves for another rank, or left the grid. The slots of the first
-      // two kinds are listed on the device (CUB's flagged select, in slot order); only the
-      // lists' upload-order indices and the leaving points come down.
-      ResortScratch                &r     = impl->resort;
-      const PointsView<dim, double> p     = impl->points.view();
-      const GridView<dim, double>   g     = impl->grid.view();
-      const std::uint8_t           *owned = impl->owned_cells.data();
-      r.keep_flag.resize(n);
-      r.leave_flag.resize(n);
-      r.slot.resize(n);
-      std::uint8_t *keep = r.keep_flag.data(), *leave = r.leave_flag.data();
-      int          *slot = r.slot.data();
-      impl->backend.for_each_node(n, [=] MPM_HOST_DEVICE(const int i) {
-        slot[i] = i;
-        if (p.material[i] < 0)
-          {
-            keep[i] = leave[i] = 0;
-            return;
-          }
-        double x[dim];
-        for (int d = 0; d < dim; ++d)
-          x[d] = p.position[d][i];
-        const bool mine = owned[lattice_cell_containing<dim>(g.origin, g.h, g.n_cells, x)] != 0;
-        keep[i]         = mine ? 1 : 0;
-        leave[i]        = mine ? 0 : 1;
-      });
-      const cudaStream_t stream = impl->backend.get_stream();
-      r.kept_slots.resize(n);
-      r.leaving_slots.resize(n);
-      r.counts.resize(2);
-      size_t bytes = 0;
-      MPM_CUDA_CHECK(cub::DeviceSelect::Flagged(nullptr, bytes, r.slot.data(), r.keep_flag.data(),
-                                                r.kept_slots.data(), r.counts.data(), n, stream));
-      r.temp.resize(std::max<size_t>(bytes, 1));
-      MPM_CUDA_CHECK(cub::DeviceSelect::Flagged(r.temp.data(), bytes, r.slot.data(), r.keep_flag.data(),
-                                                r.kept_slots.data(), r.counts.data(), n, stream));
-      MPM_CUDA_CHECK(cub::DeviceSelect::Flagged(r.temp.data(), bytes, r.slot.data(), r.leave_flag.data(),
-                                                r.leaving_slots.data(), r.counts.data() + 1, n, stream));
-      int counts[2] = {0, 0};
-      if (n > 0)
-        MPM_CUDA_CHECK(cudaMemcpyAsync(counts, r.counts.data(), sizeof(counts), cudaMemcpyDeviceToHost, stream));
-      MPM_CUDA_CHECK(cudaStreamSynchronize(stream));
-      const int n_kept = counts[0], n_leaving = counts[1];
-      r.kept_slots.resize(n_kept);
-      r.leaving_slots.resize(n_leaving);
-
-      // The labels, in upload order: those of the points that stay are gathered on the
-      // device (original[slot] is a slot's upload-order index), those of the leaving points
-      // come down packed in one copy.
-      const int *original = impl->order.original_index();
-      auto       upload_order_of = [&](const DeviceArray<int> &slots) {
-        const int m = static_cast<int>(slots.size());
-        r.index.resize(m);
-        const int *from = slots.data();
-        int       *to   = r.index.data();
-        if (m > 0)
-          impl->backend.for_each_node(m, [=] MPM_HOST_DEVICE(const int k) { to[k] = original[from[k]]; });
-      };
-      const int n_labels = static_cast<int>(impl->labels.size());
-      upload_order_of(r.leaving_slots);
-      r.leaving_labels.resize(static_cast<std::size_t>(n_labels) * n_leaving);
-      for (int k = 0; k < n_labels && n_leaving > 0; ++k)
-        {
-          gather_slots_kernel<double><<<(n_leaving + 255) / 256, 256, 0, stream>>>(
-            n_leaving, r.index.data(), impl->labels[k].data(), r.leaving_labels.data() + k * n_leaving);
-          MPM_CUDA_CHECK_LAUNCH();
-        }
-      std::vector<double> packed_labels;
-      r.leaving_labels.download(packed_labels); // waits for the gathers
-      leaving_labels.resize(n_labels);
-      for (int k = 0; k < n_labels; ++k)
-        leaving_labels[k].assign(packed_labels.begin() + k * n_leaving, packed_labels.begin() + (k + 1) * n_leaving);
-      upload_order_of(r.kept_slots);
-      for (DeviceArray<double> &array : impl->labels)
-        {
-          DeviceArray<double> &gathered = impl->slot_scratch.reals;
-          gathered.resize(n_kept);
-          if (n_kept > 0)
+          if (static_cast<long>(impl->owned_cells.size()) != impl->n_lattice_cells)
+            throw std::logic_error("DeviceEngine::take_leaving_points: the owned cells are not known");
+          if (impl->averaging_pending)
             {
-              gather_slots_kernel<double>
-                <<<(n_kept + 255) / 256, 256, 0, stream>>>(n_kept, r.index.data(), array.data(), gathered.data());
+              stages::finish_pressure_averaging(impl->backend, impl->view(), impl->points.view());
+              impl->averaging_pending = false;
+            }
+          const int n = impl->points.size();
+          // Per slot: stays, leaves for another rank, or left the grid. The slots of the first
+          // two kinds are listed on the device (CUB's flagged select, in slot order); only the
+          // lists' upload-order indices and the leaving points come down.
+          ResortScratch                &r     = impl->resort;
+          const PointsView<dim, double> p     = impl->points.view();
+          const GridView<dim, double>   g     = impl->grid.view();
+          const std::uint8_t           *owned = impl->owned_cells.data();
+          r.keep_flag.resize(n);
+          r.leave_flag.resize(n);
+          r.slot.resize(n);
+          std::uint8_t *keep = r.keep_flag.data(), *leave = r.leave_flag.data();
+          int          *slot = r.slot.data();
+          impl->backend.for_each_node(n, [=] MPM_HOST_DEVICE(const int i) {
+            slot[i] = i;
+            if (p.material[i] < 0)
+              {
+                keep[i] = leave[i] = 0;
+                return;
+              }
+            double x[dim];
+            for (int d = 0; d < dim; ++d)
+              x[d] = p.position[d][i];
+            const bool mine = owned[lattice_cell_containing<dim>(g.origin, g.h, g.n_cells, x)] != 0;
+            keep[i]         = mine ? 1 : 0;
+            leave[i]        = mine ? 0 : 1;
+          });
+          const cudaStream_t stream = impl->backend.get_stream();
+          r.kept_slots.resize(n);
+          r.leaving_slots.resize(n);
+          r.counts.resize(2);
+          size_t bytes = 0;
+          MPM_CUDA_CHECK(cub::DeviceSelect::Flagged(nullptr, bytes, r.slot.data(), r.keep_flag.data(),
+                                                    r.kept_slots.data(), r.counts.data(), n, stream));
+          r.temp.resize(std::max<size_t>(bytes, 1));
+          MPM_CUDA_CHECK(cub::DeviceSelect::Flagged(r.temp.data(), bytes, r.slot.data(), r.keep_flag.data(),
+                                                    r.kept_slots.data(), r.counts.data(), n, stream));
+          MPM_CUDA_CHECK(cub::DeviceSelect::Flagged(r.temp.data(), bytes, r.slot.data(), r.leave_flag.data(),
+                                                    r.leaving_slots.data(), r.counts.data() + 1, n, stream));
+          int counts[2] = {0, 0};
+          if (n > 0)
+            MPM_CUDA_CHECK(cudaMemcpyAsync(counts, r.counts.data(), sizeof(counts), cudaMemcpyDeviceToHost, stream));
+          MPM_CUDA_CHECK(cudaStreamSynchronize(stream));
+          const int n_kept = counts[0], n_leaving = counts[1];
+          r.kept_slots.resize(n_kept);
+          r.leaving_slots.resize(n_leaving);
+
+          // The labels, in upload order: those of the points that stay are gathered on the
+          // device (original[slot] is a slot's upload-order index), those of the leaving points
+          // come down packed in one copy.
+          const int *original = impl->order.original_index();
+          auto       upload_order_of = [&](const DeviceArray<int> &slots) {
+            const int m = static_cast<int>(slots.size());
+            r.index.resize(m);
+            const int *from = slots.data();
+            int       *to   = r.index.data();
+            if (m > 0)
+              impl->backend.for_each_node(m, [=] MPM_HOST_DEVICE(const int k) { to[k] = original[from[k]]; });
+          };
+          const int n_labels = static_cast<int>(impl->labels.size());
+          upload_order_of(r.leaving_slots);
+          r.leaving_labels.resize(static_cast<std::size_t>(n_labels) * n_leaving);
+          for (int k = 0; k < n_labels && n_leaving > 0; ++k)
+            {
+              gather_slots_kernel<double><<<(n_leaving + 255) / 256, 256, 0, stream>>>(
+                n_leaving, r.index.data(), impl->labels[k].data(), r.leaving_labels.data() + k * n_leaving);
               MPM_CUDA_CHECK_LAUNCH();
             }
-          array.swap(gathered);
+          std::vector<double> packed_labels;
+          r.leaving_labels.download(packed_labels); // waits for the gathers
+          leaving_labels.resize(n_labels);
+          for (int k = 0; k < n_labels; ++k)
+            leaving_labels[k].assign(packed_labels.begin() + k * n_leaving, packed_labels.begin() + (k + 1) * n_leaving);
+          upload_order_of(r.kept_slots);
+          for (DeviceArray<double> &array : impl->labels)
+            {
+              DeviceArray<double> &gathered = impl->slot_scratch.reals;
+              gathered.resize(n_kept);
+              if (n_kept > 0)
+                {
+                  gather_slots_kernel<double>
+                    <<<(n_kept + 255) / 256, 256, 0, stream>>>(n_kept, r.index.data(), array.data(), gathered.data());
+                  MPM_CUDA_CHECK_LAUNCH();
+                }
+              array.swap(gathered);
+            }
+          const int n_dropped = n - n_kept - n_leaving;
+          take_slots<dim>(impl->points, r.leaving_slots, leaving, impl->slot_scratch, stream);
+          keep_slots<dim>(impl->points, r.kept_slots, impl->slot_scratch, stream);
+          impl->home_cells.resize(0); // append_points sets them
+          impl->exchange.first_points = -1;
+          return n_dropped;
         }
-      const int n_dropped = n - n_kept - n_leaving;
-      take_slots<dim>(impl->points, r.leaving_slots, leaving, impl->slot_scratch, stream);
-      keep_slots<dim>(impl->points, r.kept_slots, impl->slot_scratch, stream);
-      impl->home_cells.resize(0); // append_points sets them
-      impl->exchange.first_points = -1;
-      return n_dropped;
     }
 
-    template <int dim>
-    void DeviceEngine<dim>::append_points(const HostPoints<dim, double>          &added,
+    template <int dim, typename Real>
+    void DeviceEngine<dim, Real>::append_points(const HostPoints<dim, double>          &added,
                                           const std::vector<std::vector<double>> &added_labels)
     {
-      const int          m      = impl->points.size();
-      const int          r      = added.size();
-      const cudaStream_t stream = impl->backend.get_stream();
-      if (added.n_state_variables() != impl->points.n_state_variables())
-        throw std::invalid_argument("DeviceEngine::append_points: the added points hold another number of state "
-                                    "variables than the device's");
-      if (added_labels.size() != impl->labels.size())
-        throw std::invalid_argument("DeviceEngine::append_points: not as many label arrays as were uploaded");
-      for (std::size_t k = 0; k < added_labels.size(); ++k)
+      if constexpr (!std::is_same<Real, double>::value)
+        throw std::logic_error("DeviceEngine::append_points: in double only");
+      else
         {
-          if (static_cast<int>(added_labels[k].size()) != r)
-            throw std::invalid_argument("DeviceEngine::append_points: one label per added point is needed");
-          impl->labels[k].resize_preserving(m + r, stream);
-          if (r > 0)
-            MPM_CUDA_CHECK(cudaMemcpyAsync(impl->labels[k].data() + m, added_labels[k].data(), r * sizeof(double),
-                                           cudaMemcpyHostToDevice, stream));
+          const int          m      = impl->points.size();
+          const int          r      = added.size();
+          const cudaStream_t stream = impl->backend.get_stream();
+          if (added.n_state_variables() != impl->points.n_state_variables())
+            throw std::invalid_argument("DeviceEngine::append_points: the added points hold another number of state "
+                                        "variables than the device's");
+          if (added_labels.size() != impl->labels.size())
+            throw std::invalid_argument("DeviceEngine::append_points: not as many label arrays as were uploaded");
+          for (std::size_t k = 0; k < added_labels.size(); ++k)
+            {
+              if (static_cast<int>(added_labels[k].size()) != r)
+                throw std::invalid_argument("DeviceEngine::append_points: one label per added point is needed");
+              impl->labels[k].resize_preserving(m + r, stream);
+              if (r > 0)
+                MPM_CUDA_CHECK(cudaMemcpyAsync(impl->labels[k].data() + m, added_labels[k].data(), r * sizeof(double),
+                                               cudaMemcpyHostToDevice, stream));
+            }
+          // In place where the memory held allows (it grows by an eighth when it does not).
+          for_each_point_array<dim>(impl->points, added, [&](auto &array, const auto &tail) {
+            using T = typename std::decay_t<decltype(array)>::value_type;
+            array.resize_preserving(m + r, stream);
+            if (r > 0)
+              MPM_CUDA_CHECK(
+                cudaMemcpyAsync(array.data() + m, tail.data(), r * sizeof(T), cudaMemcpyHostToDevice, stream));
+          });
+          MPM_CUDA_CHECK(cudaStreamSynchronize(stream)); // before the caller's host arrays go
+          // The new upload order, and every point at home in its current cell.
+          const int n = m + r;
+          impl->order.reset(impl->backend, n);
+          impl->steps_since_upload = 0; // sorted by stencil at the next step
+          impl->averaging_pending  = false;
+          impl->home_cells.resize(n);
+          impl->home_by_slot_stale = true;
+          const PointsView<dim, double> p    = impl->points.view();
+          const GridView<dim, double>   g    = impl->grid.view();
+          long                         *home = impl->home_cells.data();
+          impl->backend.for_each_node(n, [=] MPM_HOST_DEVICE(const int i) {
+            double x[dim];
+            for (int d = 0; d < dim; ++d)
+              x[d] = p.position[d][i];
+            const long cell = lattice_cell_containing<dim>(g.origin, g.h, g.n_cells, x);
+            home[i] = cell;
+          });
         }
-      // In place where the memory held allows (it grows by an eighth when it does not).
-      for_each_point_array<dim>(impl->points, added, [&](auto &array, const auto &tail) {
-        using T = typename std::decay_t<decltype(array)>::value_type;
-        array.resize_preserving(m + r, stream);
-        if (r > 0)
-          MPM_CUDA_CHECK(
-            cudaMemcpyAsync(array.data() + m, tail.data(), r * sizeof(T), cudaMemcpyHostToDevice, stream));
-      });
-      MPM_CUDA_CHECK(cudaStreamSynchronize(stream)); // before the caller's host arrays go
-      // The new upload order, and every point at home in its current cell.
-      const int n = m + r;
-      impl->order.reset(impl->backend, n);
-      impl->steps_since_upload = 0; // sorted by stencil at the next step
-      impl->averaging_pending  = false;
-      impl->home_cells.resize(n);
-      impl->home_by_slot_stale = true;
-      const PointsView<dim, double> p    = impl->points.view();
-      const GridView<dim, double>   g    = impl->grid.view();
-      long                         *home = impl->home_cells.data();
-      impl->backend.for_each_node(n, [=] MPM_HOST_DEVICE(const int i) {
-        double x[dim];
-        for (int d = 0; d < dim; ++d)
-          x[d] = p.position[d][i];
-        const long cell = lattice_cell_containing<dim>(g.origin, g.h, g.n_cells, x);
-        home[i] = cell;
-      });
     }
 
-    template <int dim>
-    double DeviceEngine<dim>::exchange_seconds()
+    template <int dim, typename Real>
+    double DeviceEngine<dim, Real>::exchange_seconds()
     {
       return impl->exchanged_nodes.exchange_seconds() + impl->exchanged_cells.exchange_seconds();
     }
 
-    template <int dim>
-    double DeviceEngine<dim>::share_of_points_before_overlap() const
+    template <int dim, typename Real>
+    double DeviceEngine<dim, Real>::share_of_points_before_overlap() const
     {
       return impl->n_split_sorts > 0 ? impl->first_share_sum / impl->n_split_sorts : -1;
     }
 
-    template <int dim>
-    int DeviceEngine<dim>::n_points() const
+    template <int dim, typename Real>
+    int DeviceEngine<dim, Real>::n_points() const
     {
       return impl->points.size();
     }
 
-    template <int dim>
-    int DeviceEngine<dim>::keep_nodes_near_points(const int block_cells, const FaceConditions<dim> &faces)
+    template <int dim, typename Real>
+    int DeviceEngine<dim, Real>::keep_nodes_near_points(const int block_cells, const FaceConditions<dim> &faces)
     {
-      impl->finish_pending_averaging(); // its cell sums live in the arrays replaced below
-      // On the device: every point's current cell becomes its home cell (upload order), and
-      // the blocks holding a point's cell are marked; only the marks come to the host.
-      const int                     n = impl->points.size();
-      const PointsView<dim, double> p = impl->points.view();
-      const GridView<dim, double>   g = impl->grid.view();
-      impl->home_cells.resize(n);
-      impl->block_marks.resize(n_blocks<dim>(g.n_cells, block_cells));
-      impl->block_marks.fill_bytes(0);
-      long               *home     = impl->home_cells.data();
-      std::uint8_t       *marks    = impl->block_marks.data();
-      const int          *original = impl->order.original_index(); // slot -> upload order
-      if (n > 0)
-        impl->backend.for_each_node(n, [=] MPM_HOST_DEVICE(const int i) {
-          double x[dim];
-          for (int d = 0; d < dim; ++d)
-            x[d] = p.position[d][i];
-          const long cell   = lattice_cell_containing<dim>(g.origin, g.h, g.n_cells, x);
-          home[original[i]] = cell;
-          if (p.material[i] >= 0)
-            marks[block_of_cell<dim>(cell, g.n_cells, block_cells)] = 1; // the same value from every writer
-        });
-      impl->home_by_slot_stale = true;
-      // The marked blocks listed on the device; only the list comes to the host.
-      const long n_cell_blocks = n_blocks<dim>(g.n_cells, block_cells);
-      impl->holding_list.resize(std::max<long>(std::min<long>(n_cell_blocks, n), 1));
-      impl->holding_count.resize(1);
-      impl->holding_count.fill_bytes(0);
-      const cudaStream_t stream = impl->backend.get_stream();
-      if (n > 0)
-        {
-          marked_indices_kernel<<<static_cast<unsigned int>((n_cell_blocks + 255) / 256), 256, 0, stream>>>(
-            n_cell_blocks, marks, impl->holding_list.data(), impl->holding_count.data());
-          MPM_CUDA_CHECK_LAUNCH();
-        }
-      int n_holding = 0;
-      MPM_CUDA_CHECK(
-        cudaMemcpyAsync(&n_holding, impl->holding_count.data(), sizeof(int), cudaMemcpyDeviceToHost, stream));
-      MPM_CUDA_CHECK(cudaStreamSynchronize(stream));
-      std::vector<int> holding_ints(n_holding);
-      if (n_holding > 0)
-        MPM_CUDA_CHECK(cudaMemcpy(holding_ints.data(), impl->holding_list.data(), n_holding * sizeof(int),
-                                  cudaMemcpyDeviceToHost));
-      if (!impl->chooser)
-        impl->chooser = std::make_unique<NodeBlockChooser<dim>>(g.n_cells, block_cells);
-      NodeBlockChooser<dim> &chooser = *impl->chooser;
-      chooser.choose(std::vector<long>(holding_ints.begin(), holding_ints.end()));
-      NodeBox<dim>           box;
-      const bool             as_box = box_of_kept_blocks<dim>(g.n_cells, block_cells, chooser.kept_blocks(), box);
-      const NodeBlocks<dim> &blocks = chooser.nodes();
-      const std::vector<long> box_lattice = as_box ? lattice_of_box_nodes<dim>(g.n_cells, box) : std::vector<long>();
-      const std::vector<long> &lattice_of_node = as_box ? box_lattice : blocks.lattice_of_node;
-      const long               n_nodes         = static_cast<long>(lattice_of_node.size());
-      if (n_nodes > std::numeric_limits<int>::max())
-        throw std::length_error("DeviceEngine: more nodes near the points than an int can count");
-      std::vector<std::uint8_t> node_fixed, node_friction;
-      kept_node_boundary_masks<dim>(faces, g.n_cells, lattice_of_node, node_fixed, node_friction);
-      if (as_box)
-        impl->grid.set_box(box.lower, box.nodes, node_fixed, node_friction);
+      if constexpr (!std::is_same<Real, double>::value)
+        throw std::logic_error("DeviceEngine::keep_nodes_near_points: in double only");
       else
         {
-          // The device's table: the entries set last cleared, the kept node blocks set to
-          // their slots; allocated (every entry -1) at the first use.
-          DeviceArray<int> &table = impl->grid.block_slot;
-          if (table.size() == 0)
+          impl->finish_pending_averaging(); // its cell sums live in the arrays replaced below
+          // On the device: every point's current cell becomes its home cell (upload order), and
+          // the blocks holding a point's cell are marked; only the marks come to the host.
+          const int                     n = impl->points.size();
+          const PointsView<dim, double> p = impl->points.view();
+          const GridView<dim, double>   g = impl->grid.view();
+          impl->home_cells.resize(n);
+          impl->block_marks.resize(n_blocks<dim>(g.n_cells, block_cells));
+          impl->block_marks.fill_bytes(0);
+          long               *home     = impl->home_cells.data();
+          std::uint8_t       *marks    = impl->block_marks.data();
+          const int          *original = impl->order.original_index(); // slot -> upload order
+          if (n > 0)
+            impl->backend.for_each_node(n, [=] MPM_HOST_DEVICE(const int i) {
+              double x[dim];
+              for (int d = 0; d < dim; ++d)
+                x[d] = p.position[d][i];
+              const long cell   = lattice_cell_containing<dim>(g.origin, g.h, g.n_cells, x);
+              home[original[i]] = cell;
+              if (p.material[i] >= 0)
+                marks[block_of_cell<dim>(cell, g.n_cells, block_cells)] = 1; // the same value from every writer
+            });
+          impl->home_by_slot_stale = true;
+          // The marked blocks listed on the device; only the list comes to the host.
+          const long n_cell_blocks = n_blocks<dim>(g.n_cells, block_cells);
+          impl->holding_list.resize(std::max<long>(std::min<long>(n_cell_blocks, n), 1));
+          impl->holding_count.resize(1);
+          impl->holding_count.fill_bytes(0);
+          const cudaStream_t stream = impl->backend.get_stream();
+          if (n > 0)
             {
-              table.resize(blocks.block_slot.size());
-              table.fill_bytes(0xff); // -1
+              marked_indices_kernel<<<static_cast<unsigned int>((n_cell_blocks + 255) / 256), 256, 0, stream>>>(
+                n_cell_blocks, marks, impl->holding_list.data(), impl->holding_count.data());
+              MPM_CUDA_CHECK_LAUNCH();
             }
-          auto set_entries = [&](const std::vector<long> &at, const bool to_slot) {
-            if (at.empty())
-              return;
-            impl->table_entries.upload(at);
-            set_table_entries_kernel<<<static_cast<unsigned int>((at.size() + 255) / 256), 256, 0, stream>>>(
-              static_cast<int>(at.size()), impl->table_entries.data(), table.data(), to_slot);
-            MPM_CUDA_CHECK_LAUNCH();
-            MPM_CUDA_CHECK(cudaStreamSynchronize(stream)); // before the buffer is filled again
-          };
-          set_entries(impl->table_entries_set, false);
-          set_entries(chooser.kept_node_blocks(), true);
-          impl->table_entries_set = chooser.kept_node_blocks();
-          impl->grid.use_blocks(blocks.block_cells, blocks.node_blocks, node_fixed, node_friction);
+          int n_holding = 0;
+          MPM_CUDA_CHECK(
+            cudaMemcpyAsync(&n_holding, impl->holding_count.data(), sizeof(int), cudaMemcpyDeviceToHost, stream));
+          MPM_CUDA_CHECK(cudaStreamSynchronize(stream));
+          std::vector<int> holding_ints(n_holding);
+          if (n_holding > 0)
+            MPM_CUDA_CHECK(cudaMemcpy(holding_ints.data(), impl->holding_list.data(), n_holding * sizeof(int),
+                                      cudaMemcpyDeviceToHost));
+          if (!impl->chooser)
+            impl->chooser = std::make_unique<NodeBlockChooser<dim>>(g.n_cells, block_cells);
+          NodeBlockChooser<dim> &chooser = *impl->chooser;
+          chooser.choose(std::vector<long>(holding_ints.begin(), holding_ints.end()));
+          NodeBox<dim>           box;
+          const bool             as_box = box_of_kept_blocks<dim>(g.n_cells, block_cells, chooser.kept_blocks(), box);
+          const NodeBlocks<dim> &blocks = chooser.nodes();
+          const std::vector<long> box_lattice = as_box ? lattice_of_box_nodes<dim>(g.n_cells, box) : std::vector<long>();
+          const std::vector<long> &lattice_of_node = as_box ? box_lattice : blocks.lattice_of_node;
+          const long               n_nodes         = static_cast<long>(lattice_of_node.size());
+          if (n_nodes > std::numeric_limits<int>::max())
+            throw std::length_error("DeviceEngine: more nodes near the points than an int can count");
+          std::vector<std::uint8_t> node_fixed, node_friction;
+          kept_node_boundary_masks<dim>(faces, g.n_cells, lattice_of_node, node_fixed, node_friction);
+          if (as_box)
+            impl->grid.set_box(box.lower, box.nodes, node_fixed, node_friction);
+          else
+            {
+              // The device's table: the entries set last cleared, the kept node blocks set to
+              // their slots; allocated (every entry -1) at the first use.
+              DeviceArray<int> &table = impl->grid.block_slot;
+              if (table.size() == 0)
+                {
+                  table.resize(blocks.block_slot.size());
+                  table.fill_bytes(0xff); // -1
+                }
+              auto set_entries = [&](const std::vector<long> &at, const bool to_slot) {
+                if (at.empty())
+                  return;
+                impl->table_entries.upload(at);
+                set_table_entries_kernel<<<static_cast<unsigned int>((at.size() + 255) / 256), 256, 0, stream>>>(
+                  static_cast<int>(at.size()), impl->table_entries.data(), table.data(), to_slot);
+                MPM_CUDA_CHECK_LAUNCH();
+                MPM_CUDA_CHECK(cudaStreamSynchronize(stream)); // before the buffer is filled again
+              };
+              set_entries(impl->table_entries_set, false);
+              set_entries(chooser.kept_node_blocks(), true);
+              impl->table_entries_set = chooser.kept_node_blocks();
+              impl->grid.use_blocks(blocks.block_cells, blocks.node_blocks, node_fixed, node_friction);
+            }
+          impl->numbered_by_blocks = !as_box;
+          impl->cell_sums_at_nodes = true;
+          if (impl->cell_volume.size() > 0)
+            {
+              impl->cell_volume.resize(n_nodes);
+              impl->cell_pressure_volume.resize(n_nodes);
+            }
+          return static_cast<int>(n_nodes);
         }
-      impl->numbered_by_blocks = !as_box;
-      impl->cell_sums_at_nodes = true;
-      if (impl->cell_volume.size() > 0)
-        {
-          impl->cell_volume.resize(n_nodes);
-          impl->cell_pressure_volume.resize(n_nodes);
-        }
-      return static_cast<int>(n_nodes);
     }
 
-    template <int dim>
-    GridView<dim, double> DeviceEngine<dim>::download_kept_nodes(HostGrid<dim, double> &nodes,
+    template <int dim, typename Real>
+    GridView<dim, double> DeviceEngine<dim, Real>::download_kept_nodes(HostGrid<dim, double> &nodes,
                                                                  std::vector<long>     &lattice_of_node) const
     {
-      impl->backend.synchronize();
-      const DeviceGrid<dim, double> &dg = impl->grid;
-      nodes.h                           = dg.h;
-      for (int d = 0; d < dim; ++d)
-        {
-          nodes.origin[d]  = dg.origin[d];
-          nodes.n_cells[d] = dg.n_cells[d];
-        }
-      dg.mass.download(nodes.mass);
-      for (int d = 0; d < dim; ++d)
-        dg.velocity[d].download(nodes.velocity[d]);
-      const bool as_box = !impl->numbered_by_blocks;
-      lattice_of_node   = as_box ? lattice_of_box_nodes<dim>(dg.n_cells, impl->node_box()) :
-                                   impl->chooser->nodes().lattice_of_node;
-      GridView<dim, double> view = make_grid_view<dim, double>(nodes);
-      view.lattice_to_node       = nullptr;
-      if (as_box)
-        for (int d = 0; d < dim; ++d)
-          {
-            view.box_lower[d] = dg.box_lower[d];
-            view.box_nodes[d] = dg.box_nodes[d];
-          }
+      if constexpr (!std::is_same<Real, double>::value)
+        throw std::logic_error("DeviceEngine::download_kept_nodes: in double only");
       else
         {
-          const NodeBlocks<dim> &blocks = impl->chooser->nodes(); // valid until the next choice
-          view.set_block_table(blocks.block_slot.data(), blocks.block_cells, blocks.node_blocks);
+          impl->backend.synchronize();
+          const DeviceGrid<dim, double> &dg = impl->grid;
+          nodes.h                           = dg.h;
+          for (int d = 0; d < dim; ++d)
+            {
+              nodes.origin[d]  = dg.origin[d];
+              nodes.n_cells[d] = dg.n_cells[d];
+            }
+          dg.mass.download(nodes.mass);
+          for (int d = 0; d < dim; ++d)
+            dg.velocity[d].download(nodes.velocity[d]);
+          const bool as_box = !impl->numbered_by_blocks;
+          lattice_of_node   = as_box ? lattice_of_box_nodes<dim>(dg.n_cells, impl->node_box()) :
+                                       impl->chooser->nodes().lattice_of_node;
+          GridView<dim, double> view = make_grid_view<dim, double>(nodes);
+          view.lattice_to_node       = nullptr;
+          if (as_box)
+            for (int d = 0; d < dim; ++d)
+              {
+                view.box_lower[d] = dg.box_lower[d];
+                view.box_nodes[d] = dg.box_nodes[d];
+              }
+          else
+            {
+              const NodeBlocks<dim> &blocks = impl->chooser->nodes(); // valid until the next choice
+              view.set_block_table(blocks.block_slot.data(), blocks.block_cells, blocks.node_blocks);
+            }
+          return view;
         }
-      return view;
     }
 
-    template <int dim>
-    bool DeviceEngine<dim>::kept_nodes_are_box() const
+    template <int dim, typename Real>
+    bool DeviceEngine<dim, Real>::kept_nodes_are_box() const
     {
       return impl->grid.lattice_order;
     }
 
-    template class DeviceEngine<2>;
-    template class DeviceEngine<3>;
+    template class DeviceEngine<2, double>;
+    template class DeviceEngine<3, double>;
+    template class DeviceEngine<2, float>;
+    template class DeviceEngine<3, float>;
   } // namespace cuda
 } // namespace mpm

@@ -12,10 +12,16 @@
 //   - the downloaded nodal mass sums to the points' mass;
 //   - CPDI2q in 2D (its corners in state variables, which the engine uploads, sorts with the
 //     points and downloads): a spinning elastic block, 150 steps, points and corners against the
-//     CPU within 1e-10.
+//     CPU within 1e-10;
+//   - the float engine (DeviceEngine<3, float>, Backend/Precision = float) on the same P1 steps:
+//     against the CPU's float step within 1e-5 h in position and 1e-4 of max |v| (float's
+//     round-off, 6e-8, summed in another order), against the double engine within 1e-4 h and
+//     1e-3 (and not equal to it: the step did run in float); its totals summed in double, the
+//     mass within 1e-7 of the double points' (each mass rounded once).
 #include "../core/check.h"
 #include "gpu_scenes.h"
 
+#include <mpm/core/precision.h>
 #include <mpm/cuda/device_engine.h>
 
 #include <algorithm>
@@ -83,6 +89,61 @@ void cpdi2q_through_engine()
   check(q_max > 1e-3, "CPDI2q: the corners have moved off their rectangles");
   check_below(dx, 1e-10, "CPDI2q: positions, DeviceEngine vs CPU (x/h)");
   check_below(dq, 1e-10, "CPDI2q: corners, DeviceEngine vs CPU (/h)");
+}
+
+// The float engine on P1's steps, against the CPU's float step and the double engine.
+void float_engine(HostGrid<3, double> grid, const HostPoints<3, double> &points,
+                  const std::vector<MaterialParameters<double>> &materials, StepSettings<3, double> s, const double dt,
+                  const int n_steps)
+{
+  HostGrid<3, float>                     cpu_grid = converted<float>(grid);
+  HostPoints<3, float>                   cpu_points;
+  convert_points<float>(points, cpu_points);
+  const std::vector<MaterialParameters<float>> cpu_materials = converted<float>(materials);
+  CpuBackend                                    cpu;
+  mpm::cuda::DeviceEngine<3, float>             engine(grid.view(), materials, ShapeFunction::gimp);
+  mpm::cuda::DeviceEngine<3, double>            wide(grid.view(), materials, ShapeFunction::gimp);
+  engine.upload_points(points);
+  wide.upload_points(points);
+  double time = 0;
+  for (int step = 0; step < n_steps; ++step, time += dt)
+    {
+      mpm_bench::p1_gravity(s, time);
+      explicit_step<3, GimpShape>(cpu, cpu_grid.view(), cpu_points.view(), cpu_materials.data(),
+                                  converted<float>(s), static_cast<float>(dt));
+      engine.step(s, dt);
+      wide.step(s, dt);
+    }
+  HostPoints<3, double> gpu_points, double_points;
+  engine.download_points(gpu_points);
+  wide.download_points(double_points);
+  double dx = 0, dv = 0, dx_double = 0, dv_double = 0, v_max = 0;
+  for (int i = 0; i < points.size(); ++i)
+    for (int d = 0; d < 3; ++d)
+      {
+        const double h = mpm_bench::P1::h;
+        dx             = std::max(dx, std::abs(gpu_points.position[d][i] - cpu_points.position[d][i]) / h);
+        dv             = std::max(dv, std::abs(gpu_points.velocity[d][i] - cpu_points.velocity[d][i]));
+        dx_double = std::max(dx_double, std::abs(gpu_points.position[d][i] - double_points.position[d][i]) / h);
+        dv_double = std::max(dv_double, std::abs(gpu_points.velocity[d][i] - double_points.velocity[d][i]));
+        v_max     = std::max(v_max, std::abs(double_points.velocity[d][i]));
+      }
+  double m_points = 0;
+  for (int i = 0; i < points.size(); ++i)
+    m_points += points.mass[i];
+  const PointTotals<3, double> totals = engine.totals();
+  std::printf("test_gpu_device_engine: float engine, %d steps | against the CPU in float: x/h %.1e, v %.1e | against "
+              "the double engine: x/h %.1e, v %.1e (max |v| %.2e) | mass %.1e of the double points'\n",
+              n_steps, dx, dv / v_max, dx_double, dv_double / v_max, v_max,
+              std::abs(totals.mass - m_points) / m_points);
+  check(v_max > 1e-4, "float: the points move");
+  check_below(dx, 1e-5, "float: positions, DeviceEngine vs CPU in float (x/h)");
+  check_below(dv / v_max, 1e-4, "float: velocities, DeviceEngine vs CPU in float (of max |v|)");
+  check_below(dx_double, 1e-4, "float: positions, against the double engine (x/h)");
+  check_below(dv_double / v_max, 1e-3, "float: velocities, against the double engine (of max |v|)");
+  check(dv_double > 0, "float: the float engine's velocities differ from the double engine's (it ran in float)");
+  check(totals.n_points == points.size(), "float: totals count every point");
+  check_below(std::abs(totals.mass - m_points) / m_points, 1e-7, "float: total mass against the double points'");
 }
 
 int main()
@@ -163,5 +224,8 @@ int main()
   check_below(dm / m_max, 1e-10, "nodal mass in the host's numbering: DeviceEngine vs CPU");
   check_below(dvn / v_max, 1e-10, "nodal velocity in the host's numbering: DeviceEngine vs CPU");
   check_below(std::abs(m_sum - m_points) / m_points, 1e-12, "downloaded nodal mass sums to the points' mass");
+
+  s.gravity[0] = s.gravity[1] = s.gravity[2] = 0; // p1_gravity sets them again from the start
+  float_engine(grid, points, materials, s, dt, n_steps);
   return finish("test_gpu_device_engine");
 }

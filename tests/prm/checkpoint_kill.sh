@@ -2,7 +2,7 @@
 # Kill and resume: the reduced V3 collapse (collapse_small_2d.prm, 0.3 s, about 2,600 steps,
 # a checkpoint every 100 steps) is killed while it runs and continued with --resume; its
 # final particle table must be that of the same run left alone.
-#   checkpoint_kill.sh EXE OUTDIR NP_RUN NP_RESUME SIGNAL [BACKEND] [NODES]
+#   checkpoint_kill.sh EXE OUTDIR NP_RUN NP_RESUME SIGNAL [BACKEND] [NODES] [PRECISION]
 # SIGNAL KILL: killed with SIGKILL (every rank at once, as a lost node) once a random
 # checkpoint (step 300-1500) is written; the resumed run continues from the newest complete
 # checkpoint. Same ranks: bit-identical particle tables and time steps; other ranks: equal
@@ -15,8 +15,10 @@
 # round-off (1e-10) on any ranks, at 0.3 s (the run lasts 2 s, to leave time to kill it).
 # NODES (Grid/Nodes, default all): near material chooses the nodes anew from the resumed
 # points, which must not change a bit.
+# PRECISION (Backend/Precision, default double): float saves the points in double and rounds
+# them back exactly, so a float run too must resume bit-identical.
 set -eu
-exe=$1 out=$2 np_run=$3 np_resume=$4 signal=$5 backend=${6:-cpu} nodes=${7:-all}
+exe=$1 out=$2 np_run=$3 np_resume=$4 signal=$5 backend=${6:-cpu} nodes=${7:-all} precision=${8:-double}
 if [ "$backend" = cuda ] && ! nvidia-smi -L >/dev/null 2>&1; then echo "no CUDA device: skipped"; exit 77; fi
 here=$(cd "$(dirname "$0")" && pwd)
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
@@ -28,7 +30,7 @@ sed -e "s/set End time *= .*/set End time = $end_time/" \
     "$here/collapse_small_2d.prm" > "$prm"
 printf '%s\n' "subsection Checkpoint" "  set Step interval = 100" "  set Number kept = 3" "end" \
   "subsection Parallel" "  set Load balance threshold = 1.02" "end" \
-  "subsection Backend" "  set Backend = $backend" "end" "subsection Grid" "  set Nodes = $nodes" "end" >> "$prm"
+  "subsection Backend" "  set Backend = $backend" "  set Precision = $precision" "end" "subsection Grid" "  set Nodes = $nodes" "end" >> "$prm"
 launch() { # NP ARGS...: the executable on NP ranks
   local np=$1; shift
   if [ "$np" -gt 1 ]; then mpirun --oversubscribe -np "$np" "$exe" "$@"; else "$exe" "$@"; fi

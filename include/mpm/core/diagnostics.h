@@ -20,41 +20,43 @@ namespace mpm
     long n_removed;
   };
 
-  template <int dim, typename Real, typename Backend>
-  PointTotals<dim, Real> point_totals(Backend &backend, const PointsView<dim, Real> &p)
+  // Sum: the type the totals are summed in (Real, or double for a float engine's points).
+  template <int dim, typename Real, typename Backend, typename Sum = Real>
+  PointTotals<dim, Sum> point_totals(Backend &backend, const PointsView<dim, Real> &p)
   {
-    PointTotals<dim, Real> identity;
-    identity.mass = identity.kinetic_energy = identity.removed_mass = Real(0);
+    PointTotals<dim, Sum> identity;
+    identity.mass = identity.kinetic_energy = identity.removed_mass = Sum(0);
     identity.n_points = identity.n_removed = 0;
     for (int d = 0; d < dim; ++d)
       {
-        identity.momentum[d] = Real(0);
-        identity.lower[d]    = Real(1e300);
-        identity.upper[d]    = Real(-1e300);
+        identity.momentum[d] = Sum(0);
+        identity.lower[d]    = Sum(1e300);
+        identity.upper[d]    = Sum(-1e300);
       }
     return backend.reduce_points(
       p.n_points, identity,
       [=] MPM_HOST_DEVICE(const int i) {
-        PointTotals<dim, Real> t = identity;
+        PointTotals<dim, Sum> t    = identity;
+        const Sum             mass = p.mass[i];
         if (p.material[i] < 0)
           {
-            t.removed_mass = p.mass[i];
+            t.removed_mass = mass;
             t.n_removed    = 1;
             return t;
           }
-        t.mass     = p.mass[i];
+        t.mass     = mass;
         t.n_points = 1;
         for (int d = 0; d < dim; ++d)
           {
-            const Real v = p.velocity[d][i];
-            t.kinetic_energy += Real(0.5) * p.mass[i] * v * v;
-            t.momentum[d] = p.mass[i] * v;
+            const Sum v = p.velocity[d][i];
+            t.kinetic_energy += Sum(0.5) * mass * v * v;
+            t.momentum[d] = mass * v;
             t.lower[d] = t.upper[d] = p.position[d][i];
           }
         return t;
       },
-      [] MPM_HOST_DEVICE(const PointTotals<dim, Real> &a, const PointTotals<dim, Real> &b) {
-        PointTotals<dim, Real> r;
+      [] MPM_HOST_DEVICE(const PointTotals<dim, Sum> &a, const PointTotals<dim, Sum> &b) {
+        PointTotals<dim, Sum> r;
         r.mass           = a.mass + b.mass;
         r.kinetic_energy = a.kinetic_energy + b.kinetic_energy;
         r.n_points       = a.n_points + b.n_points;

@@ -68,7 +68,12 @@ namespace mpm
     // environment sets MPM_CUDA_OVERLAP=0 (for before/after timings in one build).
     bool exchange_overlap_enabled();
 
-    template <int dim>
+    // Real: the type the device keeps the points and nodes in and steps in (double; float
+    // for Backend/Precision = float, one rank with every node only: the several-rank and
+    // near-material members throw std::logic_error there). The interface is in double either
+    // way: points, settings, nodal fields and totals are converted where they cross it, and
+    // the totals are summed in double.
+    template <int dim, typename Real = double>
     class DeviceEngine
     {
     public:

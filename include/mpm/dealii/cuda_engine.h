@@ -25,10 +25,13 @@ namespace mpm
 
   // One rank: the device keeps the lattice's nodes (lattice_grid) in lattice order, or,
   // with active_block_cells > 0, those near the points (Grid/Nodes = near material).
+  // single_precision (Backend/Precision = float, every node only): the points, nodes and
+  // step in float on the device.
   template <int dim>
   std::unique_ptr<Engine<dim>> make_cuda_engine(const HostGrid<dim, double> &lattice,
                                                 const std::vector<MaterialParameters<double>> &materials,
-                                                ShapeFunction shape, int active_block_cells = 0);
+                                                ShapeFunction shape, int active_block_cells = 0,
+                                                bool single_precision = false);
 
   // Several ranks, one GPU each (ranks of a node beyond its GPUs share them): the device
   // keeps the rank's locally relevant nodes in the grid's numbering; after each P2G pass
