@@ -81,7 +81,7 @@ namespace mpm
     };
 
     // Real: the type the device keeps the points and nodes in (float: Backend/Precision =
-    // float, one rank with every node); the interface stays in double.
+    // float, one rank); the interface stays in double.
     template <int dim, typename Real = double>
     class CudaEngine : public Engine<dim>
     {
@@ -94,6 +94,9 @@ namespace mpm
         : materials(materials)
         , shape(shape)
       {
+        for (int d = 0; d < dim; ++d)
+          lattice_origin[d] = lattice.origin[d];
+        lattice_h                  = lattice.h;
         GridView<dim, double> view = make_grid_view<dim, double>(lattice);
         if (active_block_cells > 0) // no node until the points are loaded
           {
@@ -128,7 +131,7 @@ namespace mpm
         HostGrid<dim, double> nodes;
         std::vector<long>     lattice_of_node;
         const GridView<dim, double> view = device->download_kept_nodes(nodes, lattice_of_node);
-        out                              = lattice_cells_with_mass(view, lattice_of_node);
+        out = lattice_cells_with_mass(view, lattice_of_node, lattice_origin, lattice_h);
       }
 
       // Several ranks: the device keeps this rank's locally relevant nodes, numbered as the
@@ -333,6 +336,7 @@ namespace mpm
       BackgroundGrid<dim>                    *shared_grid = nullptr;
       std::vector<MaterialParameters<double>> materials; // the latest table, for a rebuild
       FaceConditions<dim>                     faces; // one rank near the material: the kept nodes' masks
+      double lattice_origin[dim] = {}, lattice_h = 0; // one rank: the lattice's geometry in double (output)
       ShapeFunction                           shape;
       int                                     sort_interval = -1; // -1: the device's default
       // The partition the device's nodes were built for (kept alive, so a new one cannot
@@ -480,11 +484,7 @@ namespace mpm
     cuda::use_device_of_local_rank(0);
     std::cout << "  CUDA device: " << cuda::device_description() << std::endl; // one rank
     if (single_precision)
-      {
-        AssertThrow(active_block_cells == 0, // Parameters::parse refuses it with the entry's name
-                    dealii::ExcMessage("Backend/Precision = float needs every node of the grid (Grid/Nodes = all)."));
-        return std::make_unique<CudaEngine<dim, float>>(lattice, materials, shape, active_block_cells);
-      }
+      return std::make_unique<CudaEngine<dim, float>>(lattice, materials, shape, active_block_cells);
     return std::make_unique<CudaEngine<dim>>(lattice, materials, shape, active_block_cells);
 #else
     (void)single_precision;

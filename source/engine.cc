@@ -28,6 +28,9 @@ namespace mpm
         : materials(converted<Real>(materials))
         , shape(shape)
       {
+        for (int d = 0; d < dim; ++d)
+          lattice_origin[d] = lattice.origin[d];
+        lattice_h = lattice.h;
         if (active_block_cells == 0)
           {
             own_nodes = converted<Real>(lattice);
@@ -124,10 +127,7 @@ namespace mpm
       {
         AssertThrow(this->follows_material(),
                     dealii::ExcMessage("Internal: cells_with_mass() needs Nodes = near material."));
-        if constexpr (std::is_same_v<Real, double>) // nodes near the material: double only
-          out = lattice_cells_with_mass(own_view(), lattice_of_kept_node());
-        else
-          AssertThrow(false, dealii::ExcMessage("Internal: a float engine with nodes near the material."));
+        out = lattice_cells_with_mass(own_view(), lattice_of_kept_node(), lattice_origin, lattice_h);
       }
 
       unsigned int store(MaterialPoints<dim> &p) override
@@ -273,6 +273,7 @@ namespace mpm
       }
       std::vector<MaterialParameters<Real>>   materials;
       ShapeFunction                           shape;
+      double lattice_origin[dim] = {}, lattice_h = 0; // one rank: the lattice's geometry in double (output)
       CpuBackend                              backend;
       HostPoints<dim, Real>                   points;
       std::vector<long>                       home_cells; // lattice cell of each point at the last sort
@@ -299,8 +300,6 @@ namespace mpm
       {
         // Parameters::parse refuses these with the entries' names; a program calling this
         // directly gets the same reasons.
-        AssertThrow(active_block_cells == 0,
-                    dealii::ExcMessage("Backend/Precision = float needs every node of the grid (Grid/Nodes = all)."));
         for (const MaterialParameters<double> &m : materials)
           AssertThrow(m.model != MaterialModel::user_defined,
                       dealii::ExcMessage("Backend/Precision = float: a material defined outside the library steps "

@@ -144,9 +144,10 @@ namespace mpm
       field.update_ghost_values(); // as DataOut::add_data_vector's copy does
   }
 
-  template <int dim>
-  typename GridSnapshot<dim>::LatticeCells lattice_cells_with_mass(const GridView<dim, double> &nodes,
-                                                                   const std::vector<long>      &lattice_of_node)
+  template <int dim, typename Real>
+  typename GridSnapshot<dim>::LatticeCells lattice_cells_with_mass(const GridView<dim, Real> &nodes,
+                                                                   const std::vector<long>    &lattice_of_node,
+                                                                   const double origin[dim], const double h)
   {
     const int *n_cells = nodes.n_cells;
     // The cells around every node with mass: the node is vertex `corner` of the cell whose
@@ -176,7 +177,7 @@ namespace mpm
     cells.erase(std::unique(cells.begin(), cells.end()), cells.end());
     constexpr int                            n_vertices = 1 << dim;
     typename GridSnapshot<dim>::LatticeCells out;
-    out.h = nodes.h;
+    out.h = h;
     out.lower_corner.resize(cells.size());
     out.vertex_values.assign(cells.size() * n_vertices * (1 + dim), 0.0);
     for (std::size_t c = 0; c < cells.size(); ++c)
@@ -187,7 +188,7 @@ namespace mpm
           {
             idx[d] = static_cast<int>(rest % n_cells[d]);
             rest /= n_cells[d];
-            out.lower_corner[c][d] = nodes.origin[d] + idx[d] * nodes.h;
+            out.lower_corner[c][d] = origin[d] + idx[d] * h;
           }
         for (int v = 0; v < n_vertices; ++v)
           {
@@ -560,9 +561,17 @@ namespace mpm
   template struct GridSnapshot<2>;
   template struct GridSnapshot<3>;
   template typename GridSnapshot<2>::LatticeCells lattice_cells_with_mass(const GridView<2, double> &,
-                                                                          const std::vector<long> &);
+                                                                          const std::vector<long> &, const double *,
+                                                                          double);
   template typename GridSnapshot<3>::LatticeCells lattice_cells_with_mass(const GridView<3, double> &,
-                                                                          const std::vector<long> &);
+                                                                          const std::vector<long> &, const double *,
+                                                                          double);
+  template typename GridSnapshot<2>::LatticeCells lattice_cells_with_mass(const GridView<2, float> &,
+                                                                          const std::vector<long> &, const double *,
+                                                                          double);
+  template typename GridSnapshot<3>::LatticeCells lattice_cells_with_mass(const GridView<3, float> &,
+                                                                          const std::vector<long> &, const double *,
+                                                                          double);
   template class GridDataOut<2>;
   template class GridDataOut<3>;
   template class OutputWriter<2>;

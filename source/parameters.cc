@@ -446,8 +446,8 @@ namespace mpm
                       "The floating-point type of the points, the nodes and the step: double, or float (the engine's "
                       "point and node arrays in half the bytes; with Backend = cuda P2's step 1.46x faster, on the CPU "
                       "no faster: doc/performance.md; the results carry float's round-off, about 1e-7 of each value per "
-                      "operation, doc/methods.md). float runs on either backend on one MPI rank, with every node of "
-                      "the grid (Grid/Nodes = all) and the library's materials. Output, checkpoints and the time "
+                      "operation, doc/methods.md). float runs on either backend, on one MPI rank, with the library's "
+                      "materials. Output, checkpoints and the time "
                       "history are written in double either way.");
     prm.leave_subsection();
 
@@ -850,9 +850,6 @@ namespace mpm
         if (!one_rank)
           fail("Backend/Precision", "float runs on one MPI rank only (the ranks exchange their nodal sums in "
                                     "double); the allowed value on several ranks is: double.");
-        if (active_block_cells > 0)
-          fail("Backend/Precision", "float needs every node of the grid (Grid/Nodes = all); with Grid/Nodes = "
-                                    "near material the allowed value is: double.");
         for (unsigned int i = 0; i < materials.size(); ++i)
           if (materials[i].model == MaterialModel::user_defined)
             fail("Backend/Precision", "float cannot run material '" + material_names[i] + "': its model '" +

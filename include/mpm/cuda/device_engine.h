@@ -69,8 +69,8 @@ namespace mpm
     bool exchange_overlap_enabled();
 
     // Real: the type the device keeps the points and nodes in and steps in (double; float
-    // for Backend/Precision = float, one rank with every node only: the several-rank and
-    // near-material members throw std::logic_error there). The interface is in double either
+    // for Backend/Precision = float, one rank only: the several-rank members that move points
+    // throw std::logic_error there). The interface is in double either
     // way: points, settings, nodal fields and totals are converted where they cross it, and
     // the totals are summed in double.
     template <int dim, typename Real = double>

@@ -25,8 +25,8 @@ namespace mpm
 
   // One rank: the device keeps the lattice's nodes (lattice_grid) in lattice order, or,
   // with active_block_cells > 0, those near the points (Grid/Nodes = near material).
-  // single_precision (Backend/Precision = float, every node only): the points, nodes and
-  // step in float on the device.
+  // single_precision (Backend/Precision = float): the points, nodes and step in float on
+  // the device.
   template <int dim>
   std::unique_ptr<Engine<dim>> make_cuda_engine(const HostGrid<dim, double> &lattice,
                                                 const std::vector<MaterialParameters<double>> &materials,

@@ -155,7 +155,7 @@ namespace mpm
   // masks), all of them or, with active_block_cells > 0, those near the material in blocks
   // of that many cells per axis. Throws naming Backend/Backend if the requested backend is
   // not available. single_precision (Backend/Precision = float): the points, nodes and step
-  // in float (either backend); every node and built-in materials only.
+  // in float (either backend); built-in materials only.
   template <int dim>
   std::unique_ptr<Engine<dim>> make_engine(const std::string &backend, const HostGrid<dim, double> &lattice,
                                            const std::vector<MaterialParameters<double>> &materials,

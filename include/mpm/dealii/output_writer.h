@@ -80,10 +80,12 @@ namespace mpm
   // The cells of a grid that keeps only the nodes near the material (`nodes`: its
   // numbering, mass and velocity; lattice_of_node the lattice index of each node, -1 for
   // none) with mass at a vertex, in lattice order, and their vertices' mass and velocity
-  // (vertices not kept: zero).
-  template <int dim>
-  typename GridSnapshot<dim>::LatticeCells lattice_cells_with_mass(const GridView<dim, double> &nodes,
-                                                                   const std::vector<long>      &lattice_of_node);
+  // (vertices not kept: zero). Real: the nodes' type (float with Backend/Precision = float);
+  // the cells' corners come from the lattice's origin and cell size in double.
+  template <int dim, typename Real>
+  typename GridSnapshot<dim>::LatticeCells lattice_cells_with_mass(const GridView<dim, Real> &nodes,
+                                                                   const std::vector<long>    &lattice_of_node,
+                                                                   const double origin[dim], double h);
 
   // The patches deal.II's DataOut<dim> builds for the grid's Q1 fields (one per cell: its
   // vertices, each nodal field's values at them, "subdomain" as cell data), made straight
