@@ -68,11 +68,11 @@ namespace mpm
     // environment sets MPM_CUDA_OVERLAP=0 (for before/after timings in one build).
     bool exchange_overlap_enabled();
 
-    // Real: the type the device keeps the points and nodes in and steps in (double; float
-    // for Backend/Precision = float, one rank only: the several-rank members that move points
-    // throw std::logic_error there). The interface is in double either
-    // way: points, settings, nodal fields and totals are converted where they cross it, and
-    // the totals are summed in double.
+    // Real: the type the device keeps the points and nodes in and steps in: double, or float
+    // for Backend/Precision = float. The interface is in double either way: points, settings,
+    // materials, nodal fields and the step's reduction are converted where they cross it, and
+    // totals() sums in double. A float engine runs on one rank: constructing it with a
+    // NodalExchange, take_leaving_points and append_points throw std::logic_error.
     template <int dim, typename Real = double>
     class DeviceEngine
     {
