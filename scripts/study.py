@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """The method study of issue 15: scenes x methods x resolutions, each run's cost and error.
 
-Runs dealii-mpm (the CPU backend, FP64 unless --precisions says FP32 too) on each scene at each resolution with each method, and writes
+Runs dealii-mpm (the CPU backend unless --backend cuda; FP64 unless --precisions says FP32 too) on each scene at each resolution with each method, and writes
 one CSV row per run: scene, method, h, points, steps, wall_s, point_updates_per_s, error, stable,
 precision, backend, machine, date. Draws per scene the Pareto chart (error against wall time,
 log-log, one marker per method, the front of runs no other run beats in both) and, for V1, the
