@@ -8,11 +8,15 @@
 //  - the full step with averaging on leaves equal pressures per cell (MUSL, USL, USF);
 //  - the deferred averaging (explicit_step's averaging_pending: applied by the next
 //    step's P2G or by finish_pressure_averaging) gives the same points as the one done
-//    at the end of each step, to the last bit (the same operations on the same values).
+//    at the end of each step, to the last bit (the same operations on the same values);
+//    also where it is finished between two steps (as the GPU's output does when it reads
+//    the points) and the run goes on, in double and in float, with the cell sums per
+//    lattice cell and at each cell's lowest node (nodes near the material).
 #include "check.h"
 #include "scene_helpers.h"
 
 #include <mpm/core/backend/cpu_backend.h>
+#include <mpm/core/precision.h>
 #include <mpm/core/step.h>
 
 #include <algorithm>
@@ -216,6 +220,69 @@ namespace
       check(before > 0, "the deferred averaging is still pending before the finish");
     check(after == 0, "deferred averaging = averaging at the end of each step, bit for bit");
   }
+
+  // A finish between steps (an output reading the points on the GPU) and then more deferred
+  // steps: the same points as averaging at the end of every step, bit for bit.
+  template <int dim, typename Real>
+  void test_finished_between_steps(const UpdateScheme scheme, const bool sums_at_nodes)
+  {
+    std::mt19937          rng(13);
+    HostGrid<dim, double> g;
+    const double          lower[3] = {0, 0, 0};
+    const int             cells[3] = {8, 8, 8};
+    g.make_dense(lower, 0.125, cells);
+    HostPoints<dim, double> start;
+    mpm_test::random_points<dim>(start, g, 400, rng);
+    HostGrid<dim, Real> g_now = converted<Real>(g), g_between = converted<Real>(g);
+    if (sums_at_nodes) // one entry per node, a cell's at its lowest vertex
+      for (HostGrid<dim, Real> *grid : {&g_now, &g_between})
+        {
+          grid->cell_volume.assign(grid->mass.size(), Real(0));
+          grid->cell_pressure_volume.assign(grid->mass.size(), Real(0));
+        }
+    auto view = [sums_at_nodes](HostGrid<dim, Real> &grid) {
+      GridView<dim, Real> v = grid.view();
+      v.cell_sums_at_nodes  = sums_at_nodes;
+      return v;
+    };
+    HostPoints<dim, Real> now, between;
+    convert_points<Real>(start, now);
+    convert_points<Real>(start, between);
+    auto s               = converted<Real>(mpm_test::quiet_settings<dim>(scheme));
+    s.pressure_averaging = true;
+    const std::vector<MaterialParameters<Real>> materials = {converted<Real>(mpm_test::elastic(1e4, 0.3))};
+    CpuBackend                                  backend;
+    bool                                        pending = false;
+    for (int step = 0; step < 6; ++step)
+      {
+        explicit_step<dim, GimpShape>(backend, view(g_now), now.view(), materials.data(), s, Real(1e-4));
+        explicit_step<dim, GimpShape>(backend, view(g_between), between.view(), materials.data(), s, Real(1e-4),
+                                      NoGridExchange(), &pending);
+        if ((step == 1 || step == 5) && pending) // an output after steps 2 and 6
+          {
+            stages::finish_pressure_averaging(backend, view(g_between), between.view());
+            pending = false;
+          }
+      }
+    double difference = 0, scale = 0;
+    for (int i = 0; i < now.size(); ++i)
+      {
+        for (int c = 0; c < n_voigt; ++c)
+          {
+            difference = std::max(difference, double(std::fabs(now.stress[c][i] - between.stress[c][i])));
+            scale      = std::max(scale, double(std::fabs(now.stress[c][i])));
+          }
+        for (int d = 0; d < dim; ++d)
+          difference = std::max({difference, double(std::fabs(now.position[d][i] - between.position[d][i])),
+                                 double(std::fabs(now.velocity[d][i] - between.velocity[d][i]))});
+      }
+    std::printf("%dD %s, cell sums %s (scheme %d): finished between steps, largest difference %.2e (stress "
+                "scale %.2e)\n",
+                dim, sizeof(Real) == 4 ? "float" : "double", sums_at_nodes ? "at nodes" : "per cell", int(scheme),
+                difference, scale);
+    check(scale > 0, "the points carry stress");
+    check(difference == 0, "a deferred averaging finished between steps = averaging at the end of each step");
+  }
 } // namespace
 
 int main()
@@ -228,6 +295,13 @@ int main()
       test_in_step<3>(scheme);
       test_deferred<2>(scheme);
       test_deferred<3>(scheme);
+      for (const bool at_nodes : {false, true})
+        {
+          test_finished_between_steps<2, double>(scheme, at_nodes);
+          test_finished_between_steps<3, double>(scheme, at_nodes);
+          test_finished_between_steps<2, float>(scheme, at_nodes);
+          test_finished_between_steps<3, float>(scheme, at_nodes);
+        }
     }
   return mpm_test::finish("test_pressure_averaging");
 }
