@@ -285,10 +285,10 @@ namespace mpm
   }
 
   template <int dim>
-  std::size_t BackgroundGrid<dim>::exchange_bytes_per_array() const
+  std::size_t BackgroundGrid<dim>::exchange_bytes_per_array(const std::size_t value_bytes) const
   {
     // Import sends each ghost entry to its owner, export sends it back.
-    return 2 * sizeof(double) * partitioner->n_ghost_indices();
+    return 2 * value_bytes * partitioner->n_ghost_indices();
   }
 
   template <int dim>

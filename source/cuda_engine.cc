@@ -306,11 +306,7 @@ namespace mpm
 
       PointTotals<dim, double> totals() override { return device->totals(); }
 
-      // Each mass rounded to float is within 2^-24 of its double: so are their sums (in double).
-      double relative_mass_round_off() const override
-      {
-        return std::is_same<Real, double>::value ? Engine<dim>::relative_mass_round_off() : 1e-7;
-      }
+      double relative_mass_round_off() const override { return relative_mass_round_off_of<Real>(); }
 
       double max_distance_outside_home_cells() override
       {

@@ -14,8 +14,8 @@ namespace mpm
   namespace
   {
     // Real: the type the points, the nodes and the step are in (double, or float with
-    // Backend/Precision = float: one rank, every node, built-in materials; the interface stays
-    // in double and the engine converts where points, settings and totals cross it).
+    // Backend/Precision = float: built-in materials; the interface stays in double and the
+    // engine converts where points, settings and totals cross it).
     template <int dim, typename Real = double>
     class CpuEngine : public Engine<dim>
     {
@@ -50,11 +50,13 @@ namespace mpm
           own_nodes.friction_coefficient[f] = lattice.friction_coefficient[f];
       }
 
-      // Several ranks: the grid's vectors are the nodal arrays, summed over ranks.
+      // Several ranks: the nodes are the grid's local ones (owned, then ghosts), summed over
+      // ranks through its partitioner: in double the grid's vectors themselves, in float the
+      // engine's own arrays in the same numbering (shared_view).
       CpuEngine(BackgroundGrid<dim> &grid, const std::vector<MaterialParameters<double>> &materials,
                 const ShapeFunction shape)
         : shared_grid(&grid)
-        , materials(materials)
+        , materials(converted<Real>(materials))
         , shape(shape)
       {
         own_nodes.h = grid.h;
@@ -151,11 +153,23 @@ namespace mpm
         s.labels = labels;
       }
 
-      // Own nodes: copied into the grid's numbering. Shared ones are already there.
+      // Own nodes: copied into the grid's numbering. Shared ones are already there in double;
+      // in float the own arrays are in the grid's numbering already.
       void nodal_to(BackgroundGrid<dim> &grid) override
       {
         if (shared_grid != nullptr)
-          return;
+          {
+            if constexpr (!std::is_same_v<Real, double>)
+              {
+                const GridView<dim, double> to = grid.view();
+                if (static_cast<int>(own_nodes.mass.size()) != to.n_nodes) // no step since a repartition
+                  return;
+                std::copy(own_nodes.mass.begin(), own_nodes.mass.end(), to.mass);
+                for (int d = 0; d < dim; ++d)
+                  std::copy(own_nodes.velocity[d].begin(), own_nodes.velocity[d].end(), to.velocity[d]);
+              }
+            return;
+          }
         const GridView<dim, double> to = grid.view();
         const long                  n  = static_cast<long>(own_nodes.mass.size());
         if (this->follows_material()) // the others are zero (no mass, no velocity)
@@ -207,16 +221,9 @@ namespace mpm
                                                         converted<Real>(s), static_cast<Real>(dt),
                                                         NoGridExchange()));
           }
-        if constexpr (std::is_same_v<Real, double>) // several ranks: double only
-          {
-            GridView<dim, double> g = shared_grid->view();
-            g.cell_volume           = own_nodes.cell_volume.data();
-            g.cell_pressure_volume  = own_nodes.cell_pressure_volume.data();
-            return explicit_step<dim>(backend, shape, g, points.view(), materials.data(), s, dt,
-                                      shared_grid->exchange());
-          }
-        AssertThrow(false, dealii::ExcMessage("Internal: a float engine on several ranks."));
-        return {};
+        return converted<double>(explicit_step<dim>(backend, shape, shared_view(), points.view(), materials.data(),
+                                                    converted<Real>(s), static_cast<Real>(dt),
+                                                    shared_grid->exchange()));
       }
 
       // Summed in double whatever the points are in.
@@ -225,17 +232,42 @@ namespace mpm
         return point_totals<dim, Real, CpuBackend, double>(backend, points.view());
       }
 
-      // Each mass rounded to float is within 2^-24 of its double: so are their sums.
-      double relative_mass_round_off() const override
-      {
-        return std::is_same_v<Real, double> ? Engine<dim>::relative_mass_round_off() : 1e-7;
-      }
+      double relative_mass_round_off() const override { return relative_mass_round_off_of<Real>(); }
 
       long n_points() const override { return points.size(); }
 
       void set_materials(const std::vector<MaterialParameters<double>> &m) override { materials = converted<Real>(m); }
 
     private:
+      // Several ranks: the grid's lattice lookup, boundary masks and local numbering; the nodal
+      // arrays its vectors (double) or the own ones (float: reallocated, zero, when a
+      // repartition renumbered the nodes, as the grid's vectors are); the own cell sums.
+      GridView<dim, Real> shared_view()
+      {
+        const GridView<dim, double> grid = shared_grid->view();
+        GridView<dim, Real>         g;
+        if constexpr (std::is_same_v<Real, double>)
+          g = grid;
+        else
+          {
+            if (shared_grid->partitioner != nodes_built_for)
+              {
+                own_nodes.allocate_nodes(grid.n_nodes);
+                nodes_built_for = shared_grid->partitioner;
+              }
+            g = make_grid_view<dim, Real>(own_nodes);
+            g.lattice_to_node  = grid.lattice_to_node;
+            g.n_nodes          = grid.n_nodes;
+            g.fixed_components = grid.fixed_components;
+            g.friction_faces   = grid.friction_faces;
+            for (int f = 0; f < 2 * dim; ++f)
+              g.friction_coefficient[f] = static_cast<Real>(grid.friction_coefficient[f]);
+          }
+        g.cell_volume          = own_nodes.cell_volume.data();
+        g.cell_pressure_volume = own_nodes.cell_pressure_volume.data();
+        return g;
+      }
+
       // The own nodes' view; near the material, numbered as the box around them or through
       // the chooser's block table.
       GridView<dim, Real> own_view()
@@ -262,6 +294,7 @@ namespace mpm
       // the cell sums; the nodes are shared_grid's vectors.
       HostGrid<dim, Real>                     own_nodes;
       BackgroundGrid<dim>                    *shared_grid = nullptr;
+      std::shared_ptr<const dealii::Utilities::MPI::Partitioner> nodes_built_for; // float on several ranks
       std::unique_ptr<NodeBlockChooser<dim>>  chooser; // nodes near the material: their block table
       bool                                    numbered_by_box = false; // or as the box around them:
       NodeBox<dim>                            box;
@@ -315,9 +348,22 @@ namespace mpm
   template <int dim>
   std::unique_ptr<Engine<dim>> make_engine(const std::string &backend, BackgroundGrid<dim> &grid,
                                            const std::vector<MaterialParameters<double>> &materials,
-                                           const ShapeFunction shape)
+                                           const ShapeFunction shape, const bool single_precision)
   {
     check_backend(backend);
+    if (single_precision)
+      {
+        // Parameters::parse refuses these with the entries' names; a program calling this
+        // directly gets the same reasons.
+        AssertThrow(backend == "cpu", dealii::ExcMessage("Backend/Precision = float with Backend = cuda runs on one MPI "
+                                                         "rank only (the device's exchange is in double); the allowed "
+                                                         "value on several ranks is: double."));
+        for (const MaterialParameters<double> &m : materials)
+          AssertThrow(m.model != MaterialModel::user_defined,
+                      dealii::ExcMessage("Backend/Precision = float: a material defined outside the library steps "
+                                         "in double only."));
+        return std::make_unique<CpuEngine<dim, float>>(grid, materials, shape);
+      }
     if (backend == "cuda")
       return make_cuda_engine<dim>(grid, materials, shape); // throws where a rank finds no device
     return std::make_unique<CpuEngine<dim>>(grid, materials, shape);
@@ -330,7 +376,9 @@ namespace mpm
                                                   const std::vector<MaterialParameters<double>> &, ShapeFunction, int,
                                                   bool);
   template std::unique_ptr<Engine<2>> make_engine(const std::string &, BackgroundGrid<2> &,
-                                                  const std::vector<MaterialParameters<double>> &, ShapeFunction);
+                                                  const std::vector<MaterialParameters<double>> &, ShapeFunction,
+                                                  bool);
   template std::unique_ptr<Engine<3>> make_engine(const std::string &, BackgroundGrid<3> &,
-                                                  const std::vector<MaterialParameters<double>> &, ShapeFunction);
+                                                  const std::vector<MaterialParameters<double>> &, ShapeFunction,
+                                                  bool);
 } // namespace mpm

@@ -446,9 +446,9 @@ namespace mpm
                       "The floating-point type of the points, the nodes and the step: double, or float (the engine's "
                       "point and node arrays in half the bytes; with Backend = cuda P2's step 1.46x faster, on the CPU "
                       "no faster: doc/performance.md; the results carry float's round-off, about 1e-7 of each value per "
-                      "operation, doc/methods.md). float runs on either backend, on one MPI rank, with the library's "
-                      "materials. Output, checkpoints and the time "
-                      "history are written in double either way.");
+                      "operation, doc/methods.md). float runs with the library's materials, on the CPU on any number of "
+                      "MPI ranks and with Backend = cuda on one. Output, checkpoints and the time history are "
+                      "written in double either way.");
     prm.leave_subsection();
 
     prm.enter_subsection("Resources");
@@ -847,9 +847,9 @@ namespace mpm
       {
         const bool one_rank = !dealii::Utilities::MPI::job_supports_mpi() ||
                               dealii::Utilities::MPI::n_mpi_processes(MPI_COMM_WORLD) == 1;
-        if (!one_rank)
-          fail("Backend/Precision", "float runs on one MPI rank only (the ranks exchange their nodal sums in "
-                                    "double); the allowed value on several ranks is: double.");
+        if (!one_rank && backend == "cuda")
+          fail("Backend/Precision", "float with Backend = cuda runs on one MPI rank only (the devices exchange "
+                                    "their nodal sums in double); the allowed value on several ranks is: double.");
         for (unsigned int i = 0; i < materials.size(); ++i)
           if (materials[i].model == MaterialModel::user_defined)
             fail("Backend/Precision", "float cannot run material '" + material_names[i] + "': its model '" +

@@ -334,10 +334,8 @@ namespace mpm
         s.balance();
         if (cuda_ready.valid())
           cuda_ready.get();
-        AssertThrow(!parameters.single_precision, // Parameters::parse refuses it; a program setting it too
-                    dealii::ExcMessage("Backend/Precision = float runs on one MPI rank only; the allowed value on "
-                                             "several ranks is: double."));
-        s.engine = make_engine<dim>(parameters.backend, *s.grid, s.materials, parameters.shape_function);
+        s.engine = make_engine<dim>(parameters.backend, *s.grid, s.materials, parameters.shape_function,
+                                    parameters.single_precision);
         s.engine->set_sort_interval(parameters.sort_interval);
         s.engine->load(*s.points);
         s.timer.leave_subsection();
@@ -507,7 +505,10 @@ namespace mpm
         // array the scheme sums (MUSL: mass, momentum, force, then momentum again).
         const double ghosts = s.grid->partitioner->n_ghost_indices();
         const int    arrays = parameters.scheme == UpdateScheme::musl ? 3 * dim + 1 : 2 * dim + 1;
-        const double bytes  = sum(double(s.grid->exchange_bytes_per_array()), s.communicator) * arrays;
+        const double bytes  = sum(double(s.grid->exchange_bytes_per_array(parameters.single_precision ? sizeof(float) :
+                                                                                                  sizeof(double))),
+                                 s.communicator) *
+                             arrays;
         s.pcout << "  MPI: ghost nodes " << static_cast<long>(sum(ghosts, s.communicator)) << " in all, "
                 << static_cast<long>(max(ghosts, s.communicator)) << " at most on one rank; exchange " << bytes
                 << " bytes per step (" << arrays << " nodal arrays, each ghost value sent to its owner and back)\n";

@@ -654,10 +654,8 @@ namespace mpm
           points->replace(saved);
           partition_by_current_work();
           if (!engine)
-            AssertThrow(!parameters.single_precision, // Parameters::parse refuses it; a program setting it too
-                        dealii::ExcMessage("Backend/Precision = float runs on one MPI rank only; the allowed value on "
-                                             "several ranks is: double."));
-            engine = make_engine<dim>(parameters.backend, *grid, materials, parameters.shape_function);
+            engine = make_engine<dim>(parameters.backend, *grid, materials, parameters.shape_function,
+                                      parameters.single_precision);
           engine->load(*points);
         }
       else

@@ -7,9 +7,11 @@ magnitude over all its components (sum-order round-off only).
   compare_np.py REFERENCE_DIR OTHER_DIR [OTHER_DIR ...] [--rtol 1e-10] [--fields a,b] [--time T]
 Optionally (--migrated, --repartitioned) the other runs' history.csv must show points
 changing rank (n_sent > 0 and the points per rank changing) and repartitions.
---spread DIR: a second run of the reference's own setting (GPU runs, whose sums have no fixed order,
-differ from run to run); each field may then differ by up to --spread-factor (default 10) times
-DIR's own difference from the reference, or --rtol, whichever is larger."""
+--spread DIR: a run whose difference from the reference is the round-off the comparison may show: a
+second run of the reference's own setting (GPU runs, whose sums have no fixed order, differ from run
+to run), or the reference's scene in double where the reference runs in float; each field may then
+differ by up to --spread-factor (default 10) times DIR's own difference from the reference, or
+--rtol, whichever is larger."""
 import argparse
 import glob
 import os
@@ -68,7 +70,7 @@ if args.spread:
     for prefix in prefixes:
         spread = difference(ref, again, prefix)
         tolerance[prefix] = max(args.rtol, args.spread_factor * spread)
-        print(f"{args.spread}: {prefix} differs from {args.reference} by {spread:.3e} (run to run); "
+        print(f"{args.spread}: {prefix} differs from {args.reference} by {spread:.3e} (round-off); "
               f"tolerance {tolerance[prefix]:.1e}")
 for other in args.others:
     cur, n_ranks, time = final_table(other, args.time)

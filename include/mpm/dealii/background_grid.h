@@ -97,8 +97,9 @@ namespace mpm
     };
     Exchange exchange() const { return Exchange{this}; }
 
-    // Bytes one rank sends per array in one sum_nodal (import + export of its ghosts).
-    std::size_t exchange_bytes_per_array() const;
+    // Bytes one rank sends per array in one sum_nodal (import + export of its ghosts) of
+    // values of value_bytes each.
+    std::size_t exchange_bytes_per_array(std::size_t value_bytes = sizeof(double)) const;
 
     // For an engine whose arrays live elsewhere (the GPU) and come to the host only for the
     // exchange. Nodes: the local indices that sum_nodal reads or writes (the owned nodes that

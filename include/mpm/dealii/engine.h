@@ -20,6 +20,7 @@
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 namespace mpm
@@ -44,6 +45,15 @@ namespace mpm
                              "are 1 to 64: choose a smaller block size."));
       }
     return choose(); // not reached: AssertThrow(false, ...) throws
+  }
+
+  // The loss checks' tolerance on the relative mass balance of an engine whose points are in
+  // Real: the round-off of the mass sums, 1e-9 in double (their order differs from the initial
+  // sum's), 1e-7 in float (each mass rounded once: within 2^-24 of its double, so are the sums).
+  template <typename Real>
+  constexpr double relative_mass_round_off_of()
+  {
+    return std::is_same_v<Real, double> ? 1e-9 : 1e-7;
   }
 
   template <int dim>
@@ -117,10 +127,8 @@ namespace mpm
     // the box around the material (the others through the block table).
     long node_choices() const { return near_material.choices; }
     long node_choices_as_box() const { return near_material.as_box; }
-    // The loss checks' tolerance on the relative mass balance: the round-off of the mass sums
-    // (1e-9 in double, their order differing from the initial sum's); a float engine's masses
-    // are each rounded once.
-    virtual double relative_mass_round_off() const { return 1e-9; }
+    // The loss checks' tolerance on the relative mass balance (relative_mass_round_off_of).
+    virtual double relative_mass_round_off() const { return relative_mass_round_off_of<double>(); }
     // Replaces the material table (e.g. when plasticity is switched on).
     virtual void set_materials(const std::vector<MaterialParameters<double>> &materials) = 0;
 
@@ -162,10 +170,11 @@ namespace mpm
                                            ShapeFunction shape, int active_block_cells = 0,
                                            bool single_precision = false);
 
-  // Several ranks: the nodes are the grid's (cpu: its vectors; cuda: the device's copy of
-  // the rank's locally relevant nodes, exchanged through the grid's partitioner).
+  // Several ranks: the nodes are the grid's (cpu: its vectors, or in float the engine's own
+  // arrays in their numbering; cuda: the device's copy of the rank's locally relevant nodes),
+  // exchanged through the grid's partitioner. single_precision: cpu only.
   template <int dim>
   std::unique_ptr<Engine<dim>> make_engine(const std::string &backend, BackgroundGrid<dim> &grid,
                                            const std::vector<MaterialParameters<double>> &materials,
-                                           ShapeFunction shape);
+                                           ShapeFunction shape, bool single_precision = false);
 } // namespace mpm
