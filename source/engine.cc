@@ -290,8 +290,9 @@ namespace mpm
         return g;
       }
 
-      // One rank: the nodes and the cell sums. Several ranks: only the lattice geometry and
-      // the cell sums; the nodes are shared_grid's vectors.
+      // One rank: the nodes and the cell sums. Several ranks: the lattice geometry and the cell
+      // sums; the nodes are shared_grid's vectors in double, in float the arrays here in their
+      // numbering (shared_view).
       HostGrid<dim, Real>                     own_nodes;
       BackgroundGrid<dim>                    *shared_grid = nullptr;
       std::shared_ptr<const dealii::Utilities::MPI::Partitioner> nodes_built_for; // float on several ranks
