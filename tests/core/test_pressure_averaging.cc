@@ -133,17 +133,25 @@ namespace
     check_below(change, 1e-13 * scale, "averaging twice = averaging once");
   }
 
+  // The scene of the step tests: a dense grid of 8^dim cells of 0.125 and 400 random points in
+  // its middle (random stresses), drawn from `seed`.
+  template <int dim>
+  void random_scene(const unsigned int seed, HostGrid<dim, double> &g, HostPoints<dim, double> &p)
+  {
+    std::mt19937 rng(seed);
+    const double lower[3] = {0, 0, 0};
+    const int    cells[3] = {8, 8, 8};
+    g.make_dense(lower, 0.125, cells);
+    mpm_test::random_points<dim>(p, g, 400, rng);
+  }
+
   // The full step with averaging on: after each step the points of a cell share one pressure.
   template <int dim>
   void test_in_step(const UpdateScheme scheme)
   {
-    std::mt19937          rng(7);
-    HostGrid<dim, double> g;
-    const double          lower[3] = {0, 0, 0};
-    const int             cells[3] = {8, 8, 8};
-    g.make_dense(lower, 0.125, cells);
+    HostGrid<dim, double>   g;
     HostPoints<dim, double> p;
-    mpm_test::random_points<dim>(p, g, 400, rng);
+    random_scene<dim>(7, g, p);
     auto s               = mpm_test::quiet_settings<dim>(scheme);
     s.pressure_averaging = true;
     std::vector<MaterialParameters<double>> materials = {mpm_test::elastic(1e4, 0.3)};
@@ -178,15 +186,11 @@ namespace
   template <int dim>
   void test_deferred(const UpdateScheme scheme)
   {
-    std::mt19937          rng(11);
-    HostGrid<dim, double> g_now, g_later;
-    const double          lower[3] = {0, 0, 0};
-    const int             cells[3] = {8, 8, 8};
-    g_now.make_dense(lower, 0.125, cells);
-    g_later.make_dense(lower, 0.125, cells);
+    HostGrid<dim, double>   g_now;
     HostPoints<dim, double> now;
-    mpm_test::random_points<dim>(now, g_now, 400, rng);
-    HostPoints<dim, double> later = now;
+    random_scene<dim>(11, g_now, now);
+    HostGrid<dim, double>   g_later = g_now;
+    HostPoints<dim, double> later   = now;
     auto s                        = mpm_test::quiet_settings<dim>(scheme);
     s.pressure_averaging          = true;
     std::vector<MaterialParameters<double>> materials = {mpm_test::elastic(1e4, 0.3)};
@@ -226,13 +230,9 @@ namespace
   template <int dim, typename Real>
   void test_finished_between_steps(const UpdateScheme scheme, const bool sums_at_nodes)
   {
-    std::mt19937          rng(13);
-    HostGrid<dim, double> g;
-    const double          lower[3] = {0, 0, 0};
-    const int             cells[3] = {8, 8, 8};
-    g.make_dense(lower, 0.125, cells);
+    HostGrid<dim, double>   g;
     HostPoints<dim, double> start;
-    mpm_test::random_points<dim>(start, g, 400, rng);
+    random_scene<dim>(13, g, start);
     HostGrid<dim, Real> g_now = converted<Real>(g), g_between = converted<Real>(g);
     if (sums_at_nodes) // one entry per node, a cell's at its lowest vertex
       for (HostGrid<dim, Real> *grid : {&g_now, &g_between})
