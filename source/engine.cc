@@ -315,6 +315,19 @@ namespace mpm
     };
   } // namespace
 
+  namespace
+  {
+    // Parameters::parse refuses these with the entry's name; a program calling make_engine
+    // directly gets the same reason.
+    void refuse_user_materials_in_float(const std::vector<MaterialParameters<double>> &materials)
+    {
+      for (const MaterialParameters<double> &m : materials)
+        AssertThrow(m.model != MaterialModel::user_defined,
+                    dealii::ExcMessage("Backend/Precision = float: a material defined outside the library steps "
+                                       "in double only."));
+    }
+  } // namespace
+
   void check_backend(const std::string &backend)
   {
     AssertThrow(backend == "cpu" || (backend == "cuda" && cuda_engine_built()),
@@ -332,12 +345,7 @@ namespace mpm
     check_backend(backend);
     if (single_precision)
       {
-        // Parameters::parse refuses these with the entries' names; a program calling this
-        // directly gets the same reasons.
-        for (const MaterialParameters<double> &m : materials)
-          AssertThrow(m.model != MaterialModel::user_defined,
-                      dealii::ExcMessage("Backend/Precision = float: a material defined outside the library steps "
-                                         "in double only."));
+        refuse_user_materials_in_float(materials);
         if (backend == "cpu")
           return std::make_unique<CpuEngine<dim, float>>(lattice, materials, shape, active_block_cells);
       }
@@ -359,10 +367,7 @@ namespace mpm
         AssertThrow(backend == "cpu", dealii::ExcMessage("Backend/Precision = float with Backend = cuda runs on one MPI "
                                                          "rank only (the device's exchange is in double); the allowed "
                                                          "value on several ranks is: double."));
-        for (const MaterialParameters<double> &m : materials)
-          AssertThrow(m.model != MaterialModel::user_defined,
-                      dealii::ExcMessage("Backend/Precision = float: a material defined outside the library steps "
-                                         "in double only."));
+        refuse_user_materials_in_float(materials);
         return std::make_unique<CpuEngine<dim, float>>(grid, materials, shape);
       }
     if (backend == "cuda")
