@@ -312,14 +312,16 @@ namespace mpm
   }
 
   template <int dim>
-  void BackgroundGrid<dim>::sum_packed_nodes(double *values, const int count) const
+  template <typename Real>
+  void BackgroundGrid<dim>::sum_packed_nodes(Real *values, const int count) const
   {
     if (n_ranks > 1)
       node_exchange.sum_packed(partitioner, values, count);
   }
 
   template <int dim>
-  void BackgroundGrid<dim>::sum_packed_cells(double *values, const int count) const
+  template <typename Real>
+  void BackgroundGrid<dim>::sum_packed_cells(Real *values, const int count) const
   {
     if (n_ranks > 1)
       cell_exchange.sum_packed(cell_partitioner, values, count);
@@ -397,4 +399,12 @@ namespace mpm
   template void BackgroundGrid<3>::sum_cells(double *const *, int) const;
   template void BackgroundGrid<2>::sum_cells(float *const *, int) const;
   template void BackgroundGrid<3>::sum_cells(float *const *, int) const;
+  template void BackgroundGrid<2>::sum_packed_nodes(double *, int) const;
+  template void BackgroundGrid<3>::sum_packed_nodes(double *, int) const;
+  template void BackgroundGrid<2>::sum_packed_nodes(float *, int) const;
+  template void BackgroundGrid<3>::sum_packed_nodes(float *, int) const;
+  template void BackgroundGrid<2>::sum_packed_cells(double *, int) const;
+  template void BackgroundGrid<3>::sum_packed_cells(double *, int) const;
+  template void BackgroundGrid<2>::sum_packed_cells(float *, int) const;
+  template void BackgroundGrid<3>::sum_packed_cells(float *, int) const;
 } // namespace mpm

@@ -56,8 +56,16 @@ namespace mpm
       {
         timed([&] { grid.sum_packed_nodes(values, count); });
       }
+      void sum_nodal(float *values, const int count) override
+      {
+        timed([&] { grid.sum_packed_nodes(values, count); });
+      }
 
       void sum_cells(double *values, const int count) override
+      {
+        timed([&] { grid.sum_packed_cells(values, count); });
+      }
+      void sum_cells(float *values, const int count) override
       {
         timed([&] { grid.sum_packed_cells(values, count); });
       }
@@ -81,7 +89,7 @@ namespace mpm
     };
 
     // Real: the type the device keeps the points and nodes in (float: Backend/Precision =
-    // float, one rank); the interface stays in double.
+    // float); the interface, and the points that change rank, stay in double.
     template <int dim, typename Real = double>
     class CudaEngine : public Engine<dim>
     {
@@ -496,7 +504,7 @@ namespace mpm
   template <int dim>
   std::unique_ptr<Engine<dim>> make_cuda_engine(BackgroundGrid<dim> &grid,
                                                 const std::vector<MaterialParameters<double>> &materials,
-                                                const ShapeFunction shape)
+                                                const ShapeFunction shape, const bool single_precision)
   {
 #ifdef MPM_CUDA_ENGINE
     check_models(materials);
@@ -506,7 +514,7 @@ namespace mpm
     // ghost exchange travels.
     const std::vector<std::string> devices = dealii::Utilities::MPI::gather(
       grid.communicator, "GPU " + std::to_string(device) + ", " + cuda::device_description(), 0);
-    const std::size_t staged = grid.exchanged_local_nodes().size() * sizeof(double);
+    const std::size_t staged = grid.exchanged_local_nodes().size() * (single_precision ? sizeof(float) : sizeof(double));
     const std::vector<std::size_t> bytes = dealii::Utilities::MPI::gather(grid.communicator, staged, 0);
     if (dealii::Utilities::MPI::this_mpi_process(grid.communicator) == 0)
       {
@@ -520,9 +528,16 @@ namespace mpm
                   << (cuda::exchange_overlap_enabled() ? "overlapped with the passes of the points that cannot reach it" :
                                           "not overlapped (MPM_CUDA_OVERLAP=0)")
                   << std::endl;
+        if (single_precision)
+          std::cout << "  float on several GPU ranks: exchanged in float; a run that is not understood yet is "
+                       "described in doc/methods.md (\"The step in float\"): check the scene in double first"
+                    << std::endl;
       }
+    if (single_precision)
+      return std::make_unique<CudaEngine<dim, float>>(grid, materials, shape);
     return std::make_unique<CudaEngine<dim>>(grid, materials, shape);
 #else
+    (void)single_precision;
     (void)grid;
     (void)materials;
     (void)shape;
@@ -538,7 +553,9 @@ namespace mpm
                                                        const std::vector<MaterialParameters<double>> &, ShapeFunction,
                                                        int, bool);
   template std::unique_ptr<Engine<2>> make_cuda_engine(BackgroundGrid<2> &,
-                                                       const std::vector<MaterialParameters<double>> &, ShapeFunction);
+                                                       const std::vector<MaterialParameters<double>> &, ShapeFunction,
+                                                       bool);
   template std::unique_ptr<Engine<3>> make_cuda_engine(BackgroundGrid<3> &,
-                                                       const std::vector<MaterialParameters<double>> &, ShapeFunction);
+                                                       const std::vector<MaterialParameters<double>> &, ShapeFunction,
+                                                       bool);
 } // namespace mpm

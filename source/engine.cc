@@ -362,16 +362,12 @@ namespace mpm
     check_backend(backend);
     if (single_precision)
       {
-        // Parameters::parse refuses these with the entries' names; a program calling this
-        // directly gets the same reasons.
-        AssertThrow(backend == "cpu", dealii::ExcMessage("Backend/Precision = float with Backend = cuda runs on one MPI "
-                                                         "rank only (the device's exchange is in double); the allowed "
-                                                         "value on several ranks is: double."));
         refuse_user_materials_in_float(materials);
-        return std::make_unique<CpuEngine<dim, float>>(grid, materials, shape);
+        if (backend == "cpu")
+          return std::make_unique<CpuEngine<dim, float>>(grid, materials, shape);
       }
-    if (backend == "cuda")
-      return make_cuda_engine<dim>(grid, materials, shape); // throws where a rank finds no device
+    if (backend == "cuda") // throws where a rank finds no device
+      return make_cuda_engine<dim>(grid, materials, shape, single_precision);
     return std::make_unique<CpuEngine<dim>>(grid, materials, shape);
   }
 

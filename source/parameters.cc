@@ -446,8 +446,8 @@ namespace mpm
                       "The floating-point type of the points, the nodes and the step: double, or float (the engine's "
                       "point and node arrays in half the bytes; with Backend = cuda P2's step 1.46x faster, on the CPU "
                       "no faster: doc/performance.md; the results carry float's round-off, about 1e-7 of each value per "
-                      "operation, doc/methods.md). float runs with the library's materials, on the CPU on any number of "
-                      "MPI ranks and with Backend = cuda on one. Output, checkpoints and the time history are "
+                      "operation, doc/methods.md). float runs with the library's materials, on any number of MPI ranks "
+                      "with either backend (the ranks exchange their nodal sums in float). Output, checkpoints and the time history are "
                       "written in double either way.");
     prm.leave_subsection();
 
@@ -845,11 +845,6 @@ namespace mpm
     prm.leave_subsection();
     if (single_precision)
       {
-        const bool one_rank = !dealii::Utilities::MPI::job_supports_mpi() ||
-                              dealii::Utilities::MPI::n_mpi_processes(MPI_COMM_WORLD) == 1;
-        if (!one_rank && backend == "cuda")
-          fail("Backend/Precision", "float with Backend = cuda runs on one MPI rank only (the devices exchange "
-                                    "their nodal sums in double); the allowed value on several ranks is: double.");
         for (unsigned int i = 0; i < materials.size(); ++i)
           if (materials[i].model == MaterialModel::user_defined)
             fail("Backend/Precision", "float cannot run material '" + material_names[i] + "': its model '" +

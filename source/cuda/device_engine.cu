@@ -79,23 +79,25 @@ namespace mpm
     {
       // Pack and unpack of the exchanged entries, entry by entry (the host's MPI buffers'
       // layout): values[j * count + k] = arrays[k][index[j]].
+      // The values travel in the engine's type (float engines exchange half the bytes).
       constexpr int max_exchanged_arrays = 8;
+      template <typename Value>
       struct ArrayList
       {
-        double *array[max_exchanged_arrays];
+        Value *array[max_exchanged_arrays];
       };
-      template <typename Index>
-      __global__ void pack_kernel(const long n, const int count, const Index *index, const ArrayList arrays,
-                                  double *values)
+      template <typename Index, typename Value>
+      __global__ void pack_kernel(const long n, const int count, const Index *index, const ArrayList<Value> arrays,
+                                  Value *values)
       {
         const long j = blockIdx.x * static_cast<long>(blockDim.x) + threadIdx.x;
         if (j >= n * count)
           return;
         values[j] = arrays.array[j % count][index[j / count]];
       }
-      template <typename Index>
-      __global__ void unpack_kernel(const long n, const int count, const Index *index, const double *values,
-                                    const ArrayList arrays)
+      template <typename Index, typename Value>
+      __global__ void unpack_kernel(const long n, const int count, const Index *index, const Value *values,
+                                    const ArrayList<Value> arrays)
       {
         const long j = blockIdx.x * static_cast<long>(blockDim.x) + threadIdx.x;
         if (j >= n * count)
@@ -105,12 +107,12 @@ namespace mpm
 
       // One kind of exchanged entries (nodes or cells): their indices on the device, the
       // packed values on the device and in pinned host memory.
-      template <typename Index>
+      template <typename Index, typename Value>
       struct Staging
       {
         DeviceArray<Index>  index;
-        DeviceArray<double> packed;
-        double             *host   = nullptr;
+        DeviceArray<Value>  packed;
+        Value              *host   = nullptr;
         std::size_t         host_n = 0;
 
         // The device's time of each exchange, from the end of the work before it to the sums
@@ -168,12 +170,12 @@ namespace mpm
         void set_index(const std::vector<Index> &i) { index.upload(i); }
 
         // Buffers for count arrays, the events, and the arrays' list.
-        ArrayList prepare(double *const *arrays, const int count)
+        ArrayList<Value> prepare(Value *const *arrays, const int count)
         {
           if (count > max_exchanged_arrays)
             throw std::logic_error("DeviceEngine: too many arrays in one exchange");
-          const long total = static_cast<long>(index.size()) * count;
-          ArrayList  list{};
+          const long       total = static_cast<long>(index.size()) * count;
+          ArrayList<Value> list{};
           for (int k = 0; k < count; ++k)
             list.array[k] = arrays[k];
           if (packed.size() < static_cast<std::size_t>(total))
@@ -182,7 +184,7 @@ namespace mpm
             {
               cudaFreeHost(host);
               host = nullptr;
-              MPM_CUDA_CHECK(cudaMallocHost(&host, total * sizeof(double)));
+              MPM_CUDA_CHECK(cudaMallocHost(&host, total * sizeof(Value)));
               host_n = total;
             }
           if (begin[0] == nullptr)
@@ -197,7 +199,7 @@ namespace mpm
         // The overlapped exchange, first half: after the work queued so far on the backend's
         // stream, packs the arrays and copies them to the host on the side stream; returns at
         // once. The work queued next on the backend's stream must not touch an exchanged entry.
-        void begin_overlapped(CudaBackend &backend, double *const *arrays, const int count)
+        void begin_overlapped(CudaBackend &backend, Value *const *arrays, const int count)
         {
           list_in_flight = prepare(arrays, count);
           count_in_flight = count;
@@ -213,10 +215,10 @@ namespace mpm
           MPM_CUDA_CHECK(cudaStreamWaitEvent(side, begin[current], 0));
           if (total > 0)
             {
-              pack_kernel<Index><<<(total + 255) / 256, 256, 0, side>>>(static_cast<long>(index.size()), count,
+              pack_kernel<Index, Value><<<(total + 255) / 256, 256, 0, side>>>(static_cast<long>(index.size()), count,
                                                                        index.data(), list_in_flight, packed.data());
               MPM_CUDA_CHECK_LAUNCH();
-              MPM_CUDA_CHECK(cudaMemcpyAsync(host, packed.data(), total * sizeof(double), cudaMemcpyDeviceToHost, side));
+              MPM_CUDA_CHECK(cudaMemcpyAsync(host, packed.data(), total * sizeof(Value), cudaMemcpyDeviceToHost, side));
             }
           MPM_CUDA_CHECK(cudaEventRecord(copied, side));
         }
@@ -233,8 +235,8 @@ namespace mpm
           sum(host, count_in_flight);
           if (total > 0)
             {
-              MPM_CUDA_CHECK(cudaMemcpyAsync(packed.data(), host, total * sizeof(double), cudaMemcpyHostToDevice, side));
-              unpack_kernel<Index><<<(total + 255) / 256, 256, 0, side>>>(static_cast<long>(index.size()),
+              MPM_CUDA_CHECK(cudaMemcpyAsync(packed.data(), host, total * sizeof(Value), cudaMemcpyHostToDevice, side));
+              unpack_kernel<Index, Value><<<(total + 255) / 256, 256, 0, side>>>(static_cast<long>(index.size()),
                                                                          count_in_flight, index.data(), packed.data(),
                                                                          list_in_flight);
               MPM_CUDA_CHECK_LAUNCH();
@@ -245,15 +247,15 @@ namespace mpm
           current          = 1 - current;
         }
 
-        ArrayList list_in_flight{};
+        ArrayList<Value> list_in_flight{};
         int       count_in_flight = 0;
 
         // Packs count arrays, hands the host copy to sum (which replaces it by the sums over
         // the ranks), unpacks; in the stream's order, the host waits for the pack only.
         template <typename Sum>
-        void exchange(CudaBackend &backend, double *const *arrays, const int count, Sum &&sum)
+        void exchange(CudaBackend &backend, Value *const *arrays, const int count, Sum &&sum)
         {
-          const ArrayList    list    = prepare(arrays, count);
+          const ArrayList<Value> list = prepare(arrays, count);
           const long         n       = static_cast<long>(index.size());
           const long         total   = n * count;
           const cudaStream_t stream  = backend.get_stream();
@@ -262,10 +264,10 @@ namespace mpm
           MPM_CUDA_CHECK(cudaEventRecord(begin[current], stream));
           if (total > 0)
             {
-              pack_kernel<Index><<<blocks, threads, 0, stream>>>(n, count, index.data(), list, packed.data());
+              pack_kernel<Index, Value><<<blocks, threads, 0, stream>>>(n, count, index.data(), list, packed.data());
               MPM_CUDA_CHECK_LAUNCH();
               MPM_CUDA_CHECK(
-                cudaMemcpyAsync(host, packed.data(), total * sizeof(double), cudaMemcpyDeviceToHost, stream));
+                cudaMemcpyAsync(host, packed.data(), total * sizeof(Value), cudaMemcpyDeviceToHost, stream));
             }
           MPM_CUDA_CHECK(cudaStreamSynchronize(stream));
           if (pending[1 - current]) // the last exchange's pair: before this wait in the stream
@@ -274,8 +276,8 @@ namespace mpm
           if (total > 0)
             {
               MPM_CUDA_CHECK(
-                cudaMemcpyAsync(packed.data(), host, total * sizeof(double), cudaMemcpyHostToDevice, stream));
-              unpack_kernel<Index><<<blocks, threads, 0, stream>>>(n, count, index.data(), packed.data(), list);
+                cudaMemcpyAsync(packed.data(), host, total * sizeof(Value), cudaMemcpyHostToDevice, stream));
+              unpack_kernel<Index, Value><<<blocks, threads, 0, stream>>>(n, count, index.data(), packed.data(), list);
               MPM_CUDA_CHECK_LAUNCH();
             }
           MPM_CUDA_CHECK(cudaEventRecord(end[current], stream));
@@ -315,11 +317,13 @@ namespace mpm
       struct SlotScratch
       {
         DeviceArray<double> reals;
+        DeviceArray<float>  floats;
         DeviceArray<int>    ints;
         DeviceArray<char>   packed; // take_slots: every array's entries, one download
         std::vector<char>   host_packed;
 
         DeviceArray<double> &of(const DeviceArray<double> &) { return reals; }
+        DeviceArray<float>  &of(const DeviceArray<float> &) { return floats; }
         DeviceArray<int>    &of(const DeviceArray<int> &) { return ints; }
       };
 
@@ -332,9 +336,29 @@ namespace mpm
         DeviceArray<char>         temp; // CUB's
       };
 
-      // Every point array replaced by its entries at the slots, in the slots' order.
+      // The lattice in double, as the host locates points (BackgroundGrid::lattice_cell_of):
+      // the MPI re-sort on the device puts every point in the cell the host will put it in,
+      // whatever type the device steps in (a float engine's grid has its origin in float).
       template <int dim>
-      void keep_slots(DevicePoints<dim, double> &points, const DeviceArray<int> &slots, SlotScratch &scratch,
+      struct HostLattice
+      {
+        double origin[dim];
+        double h;
+        int    n_cells[dim];
+
+        template <typename Real>
+        MPM_HOST_DEVICE long cell_of(const Real *const position[dim], const int i) const
+        {
+          double x[dim];
+          for (int d = 0; d < dim; ++d)
+            x[d] = static_cast<double>(position[d][i]);
+          return lattice_cell_containing<dim>(origin, h, n_cells, x);
+        }
+      };
+
+      // Every point array replaced by its entries at the slots, in the slots' order.
+      template <int dim, typename Real>
+      void keep_slots(DevicePoints<dim, Real> &points, const DeviceArray<int> &slots, SlotScratch &scratch,
                       const cudaStream_t stream)
       {
         const int m = static_cast<int>(slots.size());
@@ -354,9 +378,9 @@ namespace mpm
 
       // The entries at the slots copied to the host, in the slots' order: gathered into one
       // packed buffer on the device, one download.
-      template <int dim>
-      void take_slots(const DevicePoints<dim, double> &points, const DeviceArray<int> &slots,
-                      HostPoints<dim, double> &host, SlotScratch &scratch, const cudaStream_t stream)
+      template <int dim, typename Real>
+      void take_slots(const DevicePoints<dim, Real> &points, const DeviceArray<int> &slots,
+                      HostPoints<dim, Real> &host, SlotScratch &scratch, const cudaStream_t stream)
       {
         const int m = static_cast<int>(slots.size());
         host.set_n_state_variables(points.n_state_variables()); // the affine transfers' matrices, if any
@@ -403,37 +427,24 @@ namespace mpm
       }
 
       // The step's exchange hook: nothing on one rank, the NodalExchange through the
-      // staging buffers otherwise.
+      // staging buffers otherwise, in the engine's type Real.
+      template <typename Real>
       struct ExchangeAdapter
       {
-        NodalExchange   *exchange = nullptr;
-        CudaBackend     *backend  = nullptr;
-        Staging<int>    *nodes    = nullptr;
-        Staging<long>   *cells    = nullptr;
-        // The exchange is in double: a float engine has none (one rank).
-        template <typename Real>
+        NodalExchange         *exchange = nullptr;
+        CudaBackend           *backend  = nullptr;
+        Staging<int, Real>    *nodes    = nullptr;
+        Staging<long, Real>   *cells    = nullptr;
+
         void sum_nodal(Real *const *arrays, const int count) const
         {
-          if constexpr (std::is_same<Real, double>::value)
-            {
-              if (exchange != nullptr)
-                nodes->exchange(*backend, arrays, count,
-                                [this](double *values, const int c) { exchange->sum_nodal(values, c); });
-            }
-          else if (exchange != nullptr)
-            throw std::logic_error("DeviceEngine: the nodal exchange runs in double only");
+          if (exchange != nullptr)
+            nodes->exchange(*backend, arrays, count, sum_of(ExchangedEntries::nodes));
         }
-        template <typename Real>
         void sum_cells(Real *const *arrays, const int count) const
         {
-          if constexpr (std::is_same<Real, double>::value)
-            {
-              if (exchange != nullptr)
-                cells->exchange(*backend, arrays, count,
-                                [this](double *values, const int c) { exchange->sum_cells(values, c); });
-            }
-          else if (exchange != nullptr)
-            throw std::logic_error("DeviceEngine: the nodal exchange runs in double only");
+          if (exchange != nullptr)
+            cells->exchange(*backend, arrays, count, sum_of(ExchangedEntries::cells));
         }
 
         // The overlap (explicit_step's pass_then_sum): the points in the device's order whose
@@ -441,25 +452,31 @@ namespace mpm
         // for the current order and home cells, or overlap off).
         int  first_points = -1;
         int  points_before_overlap() const { return exchange != nullptr ? first_points : -1; }
-        template <typename Real>
         void begin_sum(const ExchangedEntries entries, Real *const *arrays, const int count) const
         {
-          if constexpr (std::is_same<Real, double>::value)
-            {
-              if (entries == ExchangedEntries::nodes)
-                nodes->begin_overlapped(*backend, arrays, count);
-              else
-                cells->begin_overlapped(*backend, arrays, count);
-            }
+          if (entries == ExchangedEntries::nodes)
+            nodes->begin_overlapped(*backend, arrays, count);
           else
-            throw std::logic_error("DeviceEngine: the nodal exchange runs in double only");
+            cells->begin_overlapped(*backend, arrays, count);
         }
         void end_sum(const ExchangedEntries entries) const
         {
           if (entries == ExchangedEntries::nodes)
-            nodes->end_overlapped(*backend, [this](double *values, const int c) { exchange->sum_nodal(values, c); });
+            nodes->end_overlapped(*backend, sum_of(entries));
           else
-            cells->end_overlapped(*backend, [this](double *values, const int c) { exchange->sum_cells(values, c); });
+            cells->end_overlapped(*backend, sum_of(entries));
+        }
+
+      private:
+        // The host's sum over the ranks of packed values of either kind of entries.
+        auto sum_of(const ExchangedEntries entries) const
+        {
+          return [this, entries](Real *values, const int c) {
+            if (entries == ExchangedEntries::nodes)
+              exchange->sum_nodal(values, c);
+            else
+              exchange->sum_cells(values, c);
+          };
         }
       };
 
@@ -497,12 +514,13 @@ namespace mpm
       DeviceMaterials<Real>        materials;
       DeviceArray<Real>            cell_volume, cell_pressure_volume;
       long                         n_lattice_cells = 1;
+      HostLattice<dim>             host_lattice;
       ShapeFunction                shape;
       // A material asks for Hencky's law: the step runs the kernels that hold it.
       bool                         hencky = false;
-      Staging<int>                 exchanged_nodes;
-      Staging<long>                exchanged_cells;
-      ExchangeAdapter              exchange;
+      Staging<int, Real>           exchanged_nodes;
+      Staging<long, Real>          exchanged_cells;
+      ExchangeAdapter<Real>        exchange;
       DeviceArray<long>            home_cells; // several ranks: in upload order
       // The same in the device's current point order (the per-step distance check reads them
       // coalesced); gathered again after each change of order.
@@ -585,8 +603,6 @@ namespace mpm
                                     const std::vector<MaterialParameters<double>> &materials, const ShapeFunction shape,
                                     NodalExchange *exchange)
     {
-      if (!std::is_same<Real, double>::value && exchange != nullptr)
-        throw std::logic_error("DeviceEngine: the float engine runs on one rank (the exchange is in double)");
       std::string why;
       if (device_count(&why) == 0)
         throw std::runtime_error("no CUDA device: " + why);
@@ -597,11 +613,14 @@ namespace mpm
       // The host grid description: geometry, lookup and masks, nodal arrays zeroed.
       HostGrid<dim, double> host;
       host.h   = g.h;
+      impl->host_lattice.h = g.h;
       long n_lattice_nodes = 1;
       for (int d = 0; d < dim; ++d)
         {
           host.origin[d]  = g.origin[d];
           host.n_cells[d] = g.n_cells[d];
+          impl->host_lattice.origin[d]  = g.origin[d];
+          impl->host_lattice.n_cells[d] = g.n_cells[d];
           n_lattice_nodes *= g.n_cells[d] + 1;
           impl->n_lattice_cells *= g.n_cells[d];
         }
@@ -660,7 +679,7 @@ namespace mpm
       impl->grid.set_box(slab_lower, slab_nodes);
       impl->materials.upload(converted<Real>(materials));
       impl->hencky = uses_hencky(materials);
-      impl->exchange = ExchangeAdapter{exchange, &impl->backend, &impl->exchanged_nodes, &impl->exchanged_cells};
+      impl->exchange = ExchangeAdapter<Real>{exchange, &impl->backend, &impl->exchanged_nodes, &impl->exchanged_cells};
       if (exchange != nullptr)
         {
           std::vector<int> slab_nodes = exchange->exchanged_nodes();
@@ -926,164 +945,158 @@ namespace mpm
     int DeviceEngine<dim, Real>::take_leaving_points(HostPoints<dim, double>          &leaving,
                                                std::vector<std::vector<double>> &leaving_labels)
     {
-      if constexpr (!std::is_same<Real, double>::value)
-        throw std::logic_error("DeviceEngine::take_leaving_points: in double only");
-      else
-        {
-          if (static_cast<long>(impl->owned_cells.size()) != impl->n_lattice_cells)
-            throw std::logic_error("DeviceEngine::take_leaving_points: the owned cells are not known");
-          if (impl->averaging_pending)
-            {
-              stages::finish_pressure_averaging(impl->backend, impl->view(), impl->points.view());
-              impl->averaging_pending = false;
-            }
-          const int n = impl->points.size();
-          // Per slot: stays, leaves for another rank, or left the grid. The slots of the first
-          // two kinds are listed on the device (CUB's flagged select, in slot order); only the
-          // lists' upload-order indices and the leaving points come down.
-          ResortScratch                &r     = impl->resort;
-          const PointsView<dim, double> p     = impl->points.view();
-          const GridView<dim, double>   g     = impl->grid.view();
-          const std::uint8_t           *owned = impl->owned_cells.data();
-          r.keep_flag.resize(n);
-          r.leave_flag.resize(n);
-          r.slot.resize(n);
-          std::uint8_t *keep = r.keep_flag.data(), *leave = r.leave_flag.data();
-          int          *slot = r.slot.data();
-          impl->backend.for_each_node(n, [=] MPM_HOST_DEVICE(const int i) {
-            slot[i] = i;
-            if (p.material[i] < 0)
-              {
-                keep[i] = leave[i] = 0;
-                return;
-              }
-            double x[dim];
-            for (int d = 0; d < dim; ++d)
-              x[d] = p.position[d][i];
-            const bool mine = owned[lattice_cell_containing<dim>(g.origin, g.h, g.n_cells, x)] != 0;
-            keep[i]         = mine ? 1 : 0;
-            leave[i]        = mine ? 0 : 1;
-          });
-          const cudaStream_t stream = impl->backend.get_stream();
-          r.kept_slots.resize(n);
-          r.leaving_slots.resize(n);
-          r.counts.resize(2);
-          size_t bytes = 0;
-          MPM_CUDA_CHECK(cub::DeviceSelect::Flagged(nullptr, bytes, r.slot.data(), r.keep_flag.data(),
-                                                    r.kept_slots.data(), r.counts.data(), n, stream));
-          r.temp.resize(std::max<size_t>(bytes, 1));
-          MPM_CUDA_CHECK(cub::DeviceSelect::Flagged(r.temp.data(), bytes, r.slot.data(), r.keep_flag.data(),
-                                                    r.kept_slots.data(), r.counts.data(), n, stream));
-          MPM_CUDA_CHECK(cub::DeviceSelect::Flagged(r.temp.data(), bytes, r.slot.data(), r.leave_flag.data(),
-                                                    r.leaving_slots.data(), r.counts.data() + 1, n, stream));
-          int counts[2] = {0, 0};
-          if (n > 0)
-            MPM_CUDA_CHECK(cudaMemcpyAsync(counts, r.counts.data(), sizeof(counts), cudaMemcpyDeviceToHost, stream));
-          MPM_CUDA_CHECK(cudaStreamSynchronize(stream));
-          const int n_kept = counts[0], n_leaving = counts[1];
-          r.kept_slots.resize(n_kept);
-          r.leaving_slots.resize(n_leaving);
+      if (static_cast<long>(impl->owned_cells.size()) != impl->n_lattice_cells)
+        throw std::logic_error("DeviceEngine::take_leaving_points: the owned cells are not known");
+      impl->finish_pending_averaging();
+      const int n = impl->points.size();
+      // Per slot: stays, leaves for another rank, or left the grid. The slots of the first
+      // two kinds are listed on the device (CUB's flagged select, in slot order); only the
+      // lists' upload-order indices and the leaving points come down.
+      ResortScratch              &r       = impl->resort;
+      const PointsView<dim, Real> p       = impl->points.view();
+      const HostLattice<dim>      lattice = impl->host_lattice;
+      const std::uint8_t         *owned   = impl->owned_cells.data();
+      r.keep_flag.resize(n);
+      r.leave_flag.resize(n);
+      r.slot.resize(n);
+      std::uint8_t *keep = r.keep_flag.data(), *leave = r.leave_flag.data();
+      int          *slot = r.slot.data();
+      impl->backend.for_each_node(n, [=] MPM_HOST_DEVICE(const int i) {
+        slot[i] = i;
+        if (p.material[i] < 0)
+          {
+            keep[i] = leave[i] = 0;
+            return;
+          }
+        const bool mine = owned[lattice.cell_of(p.position, i)] != 0;
+        keep[i]         = mine ? 1 : 0;
+        leave[i]        = mine ? 0 : 1;
+      });
+      const cudaStream_t stream = impl->backend.get_stream();
+      r.kept_slots.resize(n);
+      r.leaving_slots.resize(n);
+      r.counts.resize(2);
+      size_t bytes = 0;
+      MPM_CUDA_CHECK(cub::DeviceSelect::Flagged(nullptr, bytes, r.slot.data(), r.keep_flag.data(),
+                                                r.kept_slots.data(), r.counts.data(), n, stream));
+      r.temp.resize(std::max<size_t>(bytes, 1));
+      MPM_CUDA_CHECK(cub::DeviceSelect::Flagged(r.temp.data(), bytes, r.slot.data(), r.keep_flag.data(),
+                                                r.kept_slots.data(), r.counts.data(), n, stream));
+      MPM_CUDA_CHECK(cub::DeviceSelect::Flagged(r.temp.data(), bytes, r.slot.data(), r.leave_flag.data(),
+                                                r.leaving_slots.data(), r.counts.data() + 1, n, stream));
+      int counts[2] = {0, 0};
+      if (n > 0)
+        MPM_CUDA_CHECK(cudaMemcpyAsync(counts, r.counts.data(), sizeof(counts), cudaMemcpyDeviceToHost, stream));
+      MPM_CUDA_CHECK(cudaStreamSynchronize(stream));
+      const int n_kept = counts[0], n_leaving = counts[1];
+      r.kept_slots.resize(n_kept);
+      r.leaving_slots.resize(n_leaving);
 
-          // The labels, in upload order: those of the points that stay are gathered on the
-          // device (original[slot] is a slot's upload-order index), those of the leaving points
-          // come down packed in one copy.
-          const int *original = impl->order.original_index();
-          auto       upload_order_of = [&](const DeviceArray<int> &slots) {
-            const int m = static_cast<int>(slots.size());
-            r.index.resize(m);
-            const int *from = slots.data();
-            int       *to   = r.index.data();
-            if (m > 0)
-              impl->backend.for_each_node(m, [=] MPM_HOST_DEVICE(const int k) { to[k] = original[from[k]]; });
-          };
-          const int n_labels = static_cast<int>(impl->labels.size());
-          upload_order_of(r.leaving_slots);
-          r.leaving_labels.resize(static_cast<std::size_t>(n_labels) * n_leaving);
-          for (int k = 0; k < n_labels && n_leaving > 0; ++k)
+      // The labels, in upload order: those of the points that stay are gathered on the
+      // device (original[slot] is a slot's upload-order index), those of the leaving points
+      // come down packed in one copy.
+      const int *original = impl->order.original_index();
+      auto       upload_order_of = [&](const DeviceArray<int> &slots) {
+        const int m = static_cast<int>(slots.size());
+        r.index.resize(m);
+        const int *from = slots.data();
+        int       *to   = r.index.data();
+        if (m > 0)
+          impl->backend.for_each_node(m, [=] MPM_HOST_DEVICE(const int k) { to[k] = original[from[k]]; });
+      };
+      const int n_labels = static_cast<int>(impl->labels.size());
+      upload_order_of(r.leaving_slots);
+      r.leaving_labels.resize(static_cast<std::size_t>(n_labels) * n_leaving);
+      for (int k = 0; k < n_labels && n_leaving > 0; ++k)
+        {
+          gather_slots_kernel<double><<<(n_leaving + 255) / 256, 256, 0, stream>>>(
+            n_leaving, r.index.data(), impl->labels[k].data(), r.leaving_labels.data() + k * n_leaving);
+          MPM_CUDA_CHECK_LAUNCH();
+        }
+      std::vector<double> packed_labels;
+      r.leaving_labels.download(packed_labels); // waits for the gathers
+      leaving_labels.resize(n_labels);
+      for (int k = 0; k < n_labels; ++k)
+        leaving_labels[k].assign(packed_labels.begin() + k * n_leaving, packed_labels.begin() + (k + 1) * n_leaving);
+      upload_order_of(r.kept_slots);
+      for (DeviceArray<double> &array : impl->labels)
+        {
+          DeviceArray<double> &gathered = impl->slot_scratch.reals;
+          gathered.resize(n_kept);
+          if (n_kept > 0)
             {
-              gather_slots_kernel<double><<<(n_leaving + 255) / 256, 256, 0, stream>>>(
-                n_leaving, r.index.data(), impl->labels[k].data(), r.leaving_labels.data() + k * n_leaving);
+              gather_slots_kernel<double>
+                <<<(n_kept + 255) / 256, 256, 0, stream>>>(n_kept, r.index.data(), array.data(), gathered.data());
               MPM_CUDA_CHECK_LAUNCH();
             }
-          std::vector<double> packed_labels;
-          r.leaving_labels.download(packed_labels); // waits for the gathers
-          leaving_labels.resize(n_labels);
-          for (int k = 0; k < n_labels; ++k)
-            leaving_labels[k].assign(packed_labels.begin() + k * n_leaving, packed_labels.begin() + (k + 1) * n_leaving);
-          upload_order_of(r.kept_slots);
-          for (DeviceArray<double> &array : impl->labels)
-            {
-              DeviceArray<double> &gathered = impl->slot_scratch.reals;
-              gathered.resize(n_kept);
-              if (n_kept > 0)
-                {
-                  gather_slots_kernel<double>
-                    <<<(n_kept + 255) / 256, 256, 0, stream>>>(n_kept, r.index.data(), array.data(), gathered.data());
-                  MPM_CUDA_CHECK_LAUNCH();
-                }
-              array.swap(gathered);
-            }
-          const int n_dropped = n - n_kept - n_leaving;
-          take_slots<dim>(impl->points, r.leaving_slots, leaving, impl->slot_scratch, stream);
-          keep_slots<dim>(impl->points, r.kept_slots, impl->slot_scratch, stream);
-          impl->home_cells.resize(0); // append_points sets them
-          impl->exchange.first_points = -1;
-          return n_dropped;
+          array.swap(gathered);
         }
+      const int n_dropped = n - n_kept - n_leaving;
+      if constexpr (std::is_same<Real, double>::value)
+        take_slots<dim>(impl->points, r.leaving_slots, leaving, impl->slot_scratch, stream);
+      else
+        {
+          HostPoints<dim, Real> taken;
+          take_slots<dim>(impl->points, r.leaving_slots, taken, impl->slot_scratch, stream);
+          convert_points<double>(taken, leaving);
+        }
+      keep_slots<dim>(impl->points, r.kept_slots, impl->slot_scratch, stream);
+      impl->home_cells.resize(0); // append_points sets them
+      impl->exchange.first_points = -1;
+      return n_dropped;
     }
 
     template <int dim, typename Real>
-    void DeviceEngine<dim, Real>::append_points(const HostPoints<dim, double>          &added,
+    void DeviceEngine<dim, Real>::append_points(const HostPoints<dim, double>          &added_in_double,
                                           const std::vector<std::vector<double>> &added_labels)
     {
-      if constexpr (!std::is_same<Real, double>::value)
-        throw std::logic_error("DeviceEngine::append_points: in double only");
-      else
+      HostPoints<dim, Real>        rounded; // a float engine's copy
+      const HostPoints<dim, Real> &added = [&]() -> const HostPoints<dim, Real> & {
+        if constexpr (std::is_same<Real, double>::value)
+          return added_in_double;
+        else
+          {
+            convert_points<Real>(added_in_double, rounded);
+            return rounded;
+          }
+      }();
+      const int          m      = impl->points.size();
+      const int          r      = added.size();
+      const cudaStream_t stream = impl->backend.get_stream();
+      if (added.n_state_variables() != impl->points.n_state_variables())
+        throw std::invalid_argument("DeviceEngine::append_points: the added points hold another number of state "
+                                    "variables than the device's");
+      if (added_labels.size() != impl->labels.size())
+        throw std::invalid_argument("DeviceEngine::append_points: not as many label arrays as were uploaded");
+      for (std::size_t k = 0; k < added_labels.size(); ++k)
         {
-          const int          m      = impl->points.size();
-          const int          r      = added.size();
-          const cudaStream_t stream = impl->backend.get_stream();
-          if (added.n_state_variables() != impl->points.n_state_variables())
-            throw std::invalid_argument("DeviceEngine::append_points: the added points hold another number of state "
-                                        "variables than the device's");
-          if (added_labels.size() != impl->labels.size())
-            throw std::invalid_argument("DeviceEngine::append_points: not as many label arrays as were uploaded");
-          for (std::size_t k = 0; k < added_labels.size(); ++k)
-            {
-              if (static_cast<int>(added_labels[k].size()) != r)
-                throw std::invalid_argument("DeviceEngine::append_points: one label per added point is needed");
-              impl->labels[k].resize_preserving(m + r, stream);
-              if (r > 0)
-                MPM_CUDA_CHECK(cudaMemcpyAsync(impl->labels[k].data() + m, added_labels[k].data(), r * sizeof(double),
-                                               cudaMemcpyHostToDevice, stream));
-            }
-          // In place where the memory held allows (it grows by an eighth when it does not).
-          for_each_point_array<dim>(impl->points, added, [&](auto &array, const auto &tail) {
-            using T = typename std::decay_t<decltype(array)>::value_type;
-            array.resize_preserving(m + r, stream);
-            if (r > 0)
-              MPM_CUDA_CHECK(
-                cudaMemcpyAsync(array.data() + m, tail.data(), r * sizeof(T), cudaMemcpyHostToDevice, stream));
-          });
-          MPM_CUDA_CHECK(cudaStreamSynchronize(stream)); // before the caller's host arrays go
-          // The new upload order, and every point at home in its current cell.
-          const int n = m + r;
-          impl->order.reset(impl->backend, n);
-          impl->steps_since_upload = 0; // sorted by stencil at the next step
-          impl->averaging_pending  = false;
-          impl->home_cells.resize(n);
-          impl->home_by_slot_stale = true;
-          const PointsView<dim, double> p    = impl->points.view();
-          const GridView<dim, double>   g    = impl->grid.view();
-          long                         *home = impl->home_cells.data();
-          impl->backend.for_each_node(n, [=] MPM_HOST_DEVICE(const int i) {
-            double x[dim];
-            for (int d = 0; d < dim; ++d)
-              x[d] = p.position[d][i];
-            const long cell = lattice_cell_containing<dim>(g.origin, g.h, g.n_cells, x);
-            home[i] = cell;
-          });
+          if (static_cast<int>(added_labels[k].size()) != r)
+            throw std::invalid_argument("DeviceEngine::append_points: one label per added point is needed");
+          impl->labels[k].resize_preserving(m + r, stream);
+          if (r > 0)
+            MPM_CUDA_CHECK(cudaMemcpyAsync(impl->labels[k].data() + m, added_labels[k].data(), r * sizeof(double),
+                                           cudaMemcpyHostToDevice, stream));
         }
+      // In place where the memory held allows (it grows by an eighth when it does not).
+      for_each_point_array<dim>(impl->points, added, [&](auto &array, const auto &tail) {
+        using T = typename std::decay_t<decltype(array)>::value_type;
+        array.resize_preserving(m + r, stream);
+        if (r > 0)
+          MPM_CUDA_CHECK(
+            cudaMemcpyAsync(array.data() + m, tail.data(), r * sizeof(T), cudaMemcpyHostToDevice, stream));
+      });
+      MPM_CUDA_CHECK(cudaStreamSynchronize(stream)); // before the caller's host arrays go
+      // The new upload order, and every point at home in its current cell.
+      const int n = m + r;
+      impl->order.reset(impl->backend, n);
+      impl->steps_since_upload = 0; // sorted by stencil at the next step
+      impl->averaging_pending  = false;
+      impl->home_cells.resize(n);
+      impl->home_by_slot_stale = true;
+      const PointsView<dim, Real> p       = impl->points.view();
+      const HostLattice<dim>      lattice = impl->host_lattice;
+      long                       *home    = impl->home_cells.data();
+      impl->backend.for_each_node(n, [=] MPM_HOST_DEVICE(const int i) { home[i] = lattice.cell_of(p.position, i); });
     }
 
     template <int dim, typename Real>

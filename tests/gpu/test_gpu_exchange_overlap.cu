@@ -43,7 +43,9 @@ namespace
     std::vector<int>  exchanged_nodes() const override { return nodes; }
     std::vector<long> exchanged_cells() const override { return cells; }
     void              sum_nodal(double *, int) override { ++n_sums; }
+    void              sum_nodal(float *, int) override { ++n_sums; }
     void              sum_cells(double *, int) override { ++n_sums; }
+    void              sum_cells(float *, int) override { ++n_sums; }
     long              n_sums = 0;
 
   private:

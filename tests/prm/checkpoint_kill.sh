@@ -21,6 +21,8 @@ set -eu
 exe=$1 out=$2 np_run=$3 np_resume=$4 signal=$5 backend=${6:-cpu} nodes=${7:-all} precision=${8:-double}
 if [ "$backend" = cuda ] && ! nvidia-smi -L >/dev/null 2>&1; then echo "no CUDA device: skipped"; exit 77; fi
 here=$(cd "$(dirname "$0")" && pwd)
+# numpy for compare_np.py: Debian's python3 (CI), else the first on PATH (GPU hosts)
+py=/usr/bin/python3; "$py" -c "import numpy" 2>/dev/null || py=python3
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
 rm -rf "$out" && mkdir -p "$out"
 prm=$out/kill_${np_run}_${np_resume}_${signal}.prm   # a name no other test's processes carry
@@ -87,7 +89,7 @@ elif [ "$backend" = cuda ]; then
   # At 0.3 s, over 1,000 steps after the checkpoint: the 2 s run settles the heap through
   # thousands of frictional contacts more, which amplify round-off as any two GPU runs
   # (whose atomic sums have no fixed order) differ by the end (doc/checkpoints.md).
-  /usr/bin/python3 "$here/compare_np.py" "$out/whole" "$out/stopped" --rtol 1e-10 --time 0.3
+  "$py" "$here/compare_np.py" "$out/whole" "$out/stopped" --rtol 1e-10 --time 0.3
 else
-  /usr/bin/python3 "$here/compare_np.py" "$out/whole" "$out/stopped" --rtol 1e-10
+  "$py" "$here/compare_np.py" "$out/whole" "$out/stopped" --rtol 1e-10
 fi

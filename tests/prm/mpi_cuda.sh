@@ -5,7 +5,9 @@
 # against the CPU) and the 3D collapse with pressure averaging (mpi_collapse_3d.sh), final
 # positions and stresses np-invariant to 1e-10 of the field's magnitude, points migrating
 # and the grid repartitioned on 4 ranks. Then the 3D scene on 2 ranks, cuda against cpu,
-# per point to the same 1e-10 (no local damping: round-off stays round-off).
+# per point to the same 1e-10 (no local damping: round-off stays round-off). And the 2D collapse
+# in float (Backend/Precision) on 1, 2 and 4 ranks, with and without pressure averaging, bounded
+# as the CPU's float test (mpi_collapse_float.sh).
 # Every step also checks the home-cell bound (MPM_VERIFY_DRIFT_BOUND).
 # Exits 77 (ctest: skipped) where no CUDA device is found.
 # Usage: mpi_cuda.sh EXE SOURCE_DIR OUTDIR
@@ -32,6 +34,11 @@ echo "== the same on 1 rank: cpu against cuda"
 bash "$here/run_np.sh" "$exe" "$here/collapse_small_2d.prm" "$out/collapse-2d-affine-cpu" "1" \
   "subsection Parallel" "  set Load balance threshold = 1.02" "end" "${affine[@]}"
 "$py" "$here/compare_np.py" "$out/collapse-2d-affine-cpu/np1" "$out/collapse-2d-affine/np1" --rtol 1e-10
+echo "== 2D collapse in float, cuda, 1 2 4 ranks (bound: float against double on 1 rank)"
+bash "$here/mpi_collapse_float.sh" "$exe" "$out/collapse-2d-float" "${cuda[@]}"
+echo "== the same with pressure averaging (its cell sums exchanged in float too)"
+bash "$here/mpi_collapse_float.sh" "$exe" "$out/collapse-2d-float-averaging" "${cuda[@]}" \
+  "subsection Solver" "  set Pressure averaging = true" "end"
 echo "== 3D collapse with pressure averaging, cuda, 1 2 4 ranks"
 bash "$here/mpi_collapse_3d.sh" "$exe" "$src" "$out/collapse-3d" "${cuda[@]}"
 echo "== 3D collapse on 2 ranks: cpu against cuda"

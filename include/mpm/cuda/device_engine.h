@@ -56,11 +56,14 @@ namespace mpm
       // Node indices (the host grid's numbering) that sum_nodal reads and writes.
       virtual std::vector<int> exchanged_nodes() const = 0;
       // values[j * count + k] is array k at exchanged_nodes()[j] (entry by entry); on
-      // return, the sums over the ranks.
+      // return, the sums over the ranks. In the engine's type: float engines call the
+      // float overloads.
       virtual void sum_nodal(double *values, int count) = 0;
+      virtual void sum_nodal(float *values, int count)  = 0;
       // The same for the pressure averaging's cell arrays, indexed by lattice cell.
       virtual std::vector<long> exchanged_cells() const = 0;
       virtual void              sum_cells(double *values, int count) = 0;
+      virtual void              sum_cells(float *values, int count)  = 0;
     };
 
     // Whether the engines on several ranks overlap the exchange with the passes of the points
@@ -71,8 +74,8 @@ namespace mpm
     // Real: the type the device keeps the points and nodes in and steps in: double, or float
     // for Backend/Precision = float. The interface is in double either way: points, settings,
     // materials, nodal fields and the step's reduction are converted where they cross it, and
-    // totals() sums in double. A float engine runs on one rank: constructing it with a
-    // NodalExchange, take_leaving_points and append_points throw std::logic_error.
+    // totals() sums in double. On several ranks the ghost entries are exchanged in Real;
+    // the points that change rank and their labels cross in double.
     template <int dim, typename Real = double>
     class DeviceEngine
     {

@@ -113,8 +113,10 @@ namespace mpm
     void sum_local_cells(Real *const *arrays, int count) const;
     // The sums on those entries only, packed entry by entry: values[j * count + k] is array
     // k at exchanged_local_nodes()[j] (exchanged_local_cells()[j]); InterleavedExchange::sum_packed.
-    void sum_packed_nodes(double *values, int count) const;
-    void sum_packed_cells(double *values, int count) const;
+    template <typename Real>
+    void sum_packed_nodes(Real *values, int count) const;
+    template <typename Real>
+    void sum_packed_cells(Real *values, int count) const;
 
     MPI_Comm                                  communicator;
     unsigned int                              n_ranks;

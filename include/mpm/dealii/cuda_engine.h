@@ -36,9 +36,10 @@ namespace mpm
   // Several ranks, one GPU each (ranks of a node beyond its GPUs share them): the device
   // keeps the rank's locally relevant nodes in the grid's numbering; after each P2G pass
   // the ghost and import entries are packed on the device, staged through pinned host
-  // memory and summed over the ranks by the grid's Partitioner. Collective.
+  // memory and summed over the ranks by the grid's Partitioner (in float where
+  // single_precision: half the bytes). Collective.
   template <int dim>
   std::unique_ptr<Engine<dim>> make_cuda_engine(BackgroundGrid<dim> &grid,
                                                 const std::vector<MaterialParameters<double>> &materials,
-                                                ShapeFunction shape);
+                                                ShapeFunction shape, bool single_precision = false);
 } // namespace mpm
