@@ -9,10 +9,7 @@ set -u -o pipefail
 out=$1
 here=$(cd "$(dirname "$0")" && pwd)
 . "$here/gpu_unpack_build.sh"
-mkdir -p "$out"
-prepare_build "${BIN:-build-cuda/dev}" "$out"
-exe=$(readlink -f "${BIN:-build-cuda/dev}/dealii-mpm")
-export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
+prepare_mpi_runs "${BIN:-build-cuda/dev}" "$out"
 start=$(date +%s)
 timeout 360 bash "$here/../tests/prm/mpi_cuda.sh" "$exe" "$here/.." "$out/mpi_cuda" >"$out/mpi_cuda.log" 2>&1
 echo "== tests/prm/mpi_cuda.sh: rc $? ($(($(date +%s) - start)) s)"

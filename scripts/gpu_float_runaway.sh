@@ -11,10 +11,7 @@ set -u -o pipefail
 out=$1
 here=$(cd "$(dirname "$0")" && pwd)
 . "$here/gpu_unpack_build.sh"
-mkdir -p "$out"
-prepare_build "${BIN:-build-cuda/dev}" "$out"
-exe=$(readlink -f "${BIN:-build-cuda/dev}/dealii-mpm")
-export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
+prepare_mpi_runs "${BIN:-build-cuda/dev}" "$out"
 # The checkpoint test's scene (tests/prm/checkpoint_kill.sh with Backend = cuda, float, 2 ranks).
 scene() { # DIR CHECKPOINT_INTERVAL FLIP
   sed -e "s/set End time *= .*/set End time = 2/" -e "s/set FLIP fraction *= .*/set FLIP fraction = $3/" \

@@ -20,3 +20,12 @@ prepare_build() {
   export OMPI_MCA_ess_singleton_isolated=1
   nvidia-smi --query-gpu=name,driver_version,memory.total --format=csv,noheader | tee "$2/machine.txt"
 }
+
+# prepare_mpi_runs DIR OUT: prepare_build DIR OUT (OUT created), `exe` set to DIR's dealii-mpm (absolute), and
+# mpirun allowed as root.
+prepare_mpi_runs() {
+  mkdir -p "$2"
+  prepare_build "$1" "$2"
+  exe=$(readlink -f "$1/dealii-mpm")
+  export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
+}
