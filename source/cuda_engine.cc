@@ -529,9 +529,7 @@ namespace mpm
                                           "not overlapped (MPM_CUDA_OVERLAP=0)")
                   << std::endl;
         if (single_precision)
-          std::cout << "  float on several GPU ranks: exchanged in float; a run that is not understood yet is "
-                       "described in doc/methods.md (\"The step in float\"): check the scene in double first"
-                    << std::endl;
+          std::cout << "  float on several GPU ranks: the nodal and cell sums exchanged in float" << std::endl;
       }
     if (single_precision)
       return std::make_unique<CudaEngine<dim, float>>(grid, materials, shape);

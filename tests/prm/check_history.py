@@ -7,6 +7,8 @@
   --energy-bounded            the kinetic energy never exceeds the work done by gravity (+1%; the
                               initial elastic energy of the scenes that use it is negligible)
   --at-rest F                 the final kinetic energy is below F times the work done by gravity
+  --at-rest-after T,F         on every row from time T on, the kinetic energy is below F times the
+                              work done by gravity (a settled heap that no burst of energy wakes)
   (with --removed-at-least, also: the mass left is that of the points left, and on every row
   the mass left and the removed mass make the initial mass, the run's own loss check)"""
 import argparse
@@ -28,6 +30,7 @@ parser.add_argument("--removed-at-least", type=int, default=0)
 parser.add_argument("--none-removed", action="store_true")
 parser.add_argument("--energy-bounded", action="store_true")
 parser.add_argument("--at-rest", type=float)
+parser.add_argument("--at-rest-after")
 args = parser.parse_args()
 
 h = mpm_results.history(args.output_dir)
@@ -86,5 +89,15 @@ if args.at_rest is not None:
     print(f"final kinetic energy / work of gravity: {ratio:.3e} (tolerance {args.at_rest:.1e})")
     if not ratio <= args.at_rest:
         print("FAILED: not at rest at the end")
+        failed = True
+if args.at_rest_after is not None:
+    since, bound = (float(v) for v in args.at_rest_after.split(","))
+    rows = h["time"] >= since
+    ratio = h["kinetic_energy"][rows] / np.maximum(h["work_of_gravity"][rows], 1e-300)
+    worst = int(np.argmax(ratio))
+    print(f"kinetic energy / work of gravity from t = {since} s: at most {ratio[worst]:.3e} at t = "
+          f"{h['time'][rows][worst]:.4f} s (tolerance {bound:.1e}), {int(np.sum(rows))} rows")
+    if not (np.sum(rows) > 0 and ratio[worst] <= bound):
+        print("FAILED: the kinetic energy rose again after the heap had settled")
         failed = True
 sys.exit(1 if failed else 0)

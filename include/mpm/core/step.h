@@ -921,7 +921,10 @@ namespace mpm
             kinematics.d_spin = dW;
             kinematics.f      = dF;
             kinematics.J      = p.volume[i] / p.initial_volume[i]; // before the update below
-            // F <- (I + L dt) F; the volume follows det F.
+            // F <- (I + L dt) F; the volume by det(I + L dt), whose product over the steps is
+            // det F: computed from F it would lose its digits where F is far from a rotation
+            // (a point sheared along a no-slip base: entries of thousands, det F of a few, and
+            // in float none of its digits left, a negative volume; doc/methods.md).
             if (!s.hold_points)
               {
                 Mat3<Real> F = Mat3<Real>::identity();
@@ -932,7 +935,7 @@ namespace mpm
                 for (int a = 0; a < dim; ++a)
                   for (int b = 0; b < dim; ++b)
                     p.deformation_gradient[a * dim + b][i] = F.a[a][b];
-                p.volume[i] = p.initial_volume[i] * determinant(F);
+                p.volume[i] *= determinant(dF);
               }
             kinematics.J_new = p.volume[i] / p.initial_volume[i];
             MaterialPointState<Real> state;
