@@ -17,7 +17,7 @@
 # points, which must not change a bit.
 # PRECISION (Backend/Precision, default double): float saves the points in double and rounds
 # them back exactly, so a float run too must resume bit-identical (CPU only: float GPU runs are
-# not reproducible to the bit, and one ran away on two GPU ranks; doc/checkpoints.md).
+# not reproducible to the bit; doc/checkpoints.md).
 set -eu
 exe=$1 out=$2 np_run=$3 np_resume=$4 signal=$5 backend=${6:-cpu} nodes=${7:-all} precision=${8:-double}
 if [ "$backend" = cuda ] && ! nvidia-smi -L >/dev/null 2>&1; then echo "no CUDA device: skipped"; exit 77; fi
