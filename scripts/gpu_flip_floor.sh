@@ -1,8 +1,8 @@
 #!/bin/bash
 # The reduced collapse (tests/prm/collapse_small_2d.prm to 2 s, pure FLIP, no-slip base) on one rank with
 # Backend = cuda (double, float) and cpu (double) on the same machine: kinetic energy over time and the fastest
-# point per output (scripts/float_runaway_where.py). On the CPU points near the floor keep a FLIP velocity
-# (0.77 m/s) they do not move with, 0.035 J at 2 s; the GPU's float runs had ended near 3.4e-6 J.
+# point per output (scripts/float_runaway_where.py). Points near the floor keep FLIP velocities (up to 0.77 m/s)
+# they do not move with, 0.035 J at 2 s, on either backend (doc/methods.md, "Pure FLIP at a no-slip base").
 #   . /opt/dl/dl-env.sh && BIN=build-cuda/dev bash scripts/gpu_flip_floor.sh OUTDIR
 set -u -o pipefail
 out=$1
