@@ -6,6 +6,8 @@ first grew tenfold over its smallest value after the heap came to rest (t >= 0.5
 
   python3 float_runaway_where.py RUN_DIR OUTPUT_INTERVAL [FROM_TIME [EVERY]]
 
+2D runs (velocity_x, velocity_y).
+
 FROM_TIME (and every EVERY-th output from it) prints those outputs instead, whether the run ran away or not.
 """
 import glob
@@ -14,6 +16,8 @@ import re
 import sys
 
 import numpy as np
+
+import mpm_results
 
 
 def tables(run):
@@ -47,15 +51,20 @@ def main():
             ranges.append(f"rank {rank} x {t['position_x'].min():.4f}-{t['position_x'].max():.4f}")
             if fastest is None or speed[i] > fastest[0]:
                 fastest = (speed[i], int(t["id"][i]), t["position_x"][i], t["position_y"][i], rank)
-        rows.append((counter * interval, fastest, "; ".join(ranges)))
-    history = np.genfromtxt(os.path.join(run, "history.csv"), delimiter=",", names=True)
-    rest = history[history["time"] >= 0.5]
+        if fastest is not None:
+            rows.append((counter * interval, fastest, "; ".join(ranges)))
+    if not rows:
+        sys.exit(f"float_runaway_where.py: no particle_table_*.csv with points in {run} "
+                 "(Output/Write particle table = true?)")
+    history = mpm_results.history(run)
+    at_rest = history["time"] >= 0.5
+    energy, times = history["kinetic_energy"][at_rest], history["time"][at_rest]
     start = None
-    if len(rest):
-        low = np.minimum.accumulate(rest["kinetic_energy"])
-        grown = np.nonzero(rest["kinetic_energy"] > 10 * low)[0]
+    if len(energy):
+        low = np.minimum.accumulate(energy)
+        grown = np.nonzero(energy > 10 * low)[0]
         if len(grown):
-            start = rest["time"][grown[0]]
+            start = times[grown[0]]
             print(f"  kinetic energy tenfold its low ({low[grown[0]]:.3e} J) at t = {start:.4f} s")
     if from_time is None:
         from_time = start - interval if start is not None else 1.8

@@ -91,13 +91,21 @@ if args.at_rest is not None:
         print("FAILED: not at rest at the end")
         failed = True
 if args.at_rest_after is not None:
-    since, bound = (float(v) for v in args.at_rest_after.split(","))
+    try:
+        since, bound = (float(v) for v in args.at_rest_after.split(","))
+    except ValueError:
+        sys.exit(f"check_history.py: --at-rest-after takes T,F (two numbers), not '{args.at_rest_after}'")
     rows = h["time"] >= since
-    ratio = h["kinetic_energy"][rows] / np.maximum(h["work_of_gravity"][rows], 1e-300)
-    worst = int(np.argmax(ratio))
-    print(f"kinetic energy / work of gravity from t = {since} s: at most {ratio[worst]:.3e} at t = "
-          f"{h['time'][rows][worst]:.4f} s (tolerance {bound:.1e}), {int(np.sum(rows))} rows")
-    if not (np.sum(rows) > 0 and ratio[worst] <= bound):
-        print("FAILED: the kinetic energy rose again after the heap had settled")
+    if not np.any(rows):
+        print(f"FAILED: --at-rest-after: no history row from t = {since} s on (the run ended at "
+              f"{h['time'][-1]} s)")
         failed = True
+    else:
+        ratio = h["kinetic_energy"][rows] / np.maximum(h["work_of_gravity"][rows], 1e-300)
+        worst = int(np.argmax(ratio))
+        print(f"kinetic energy / work of gravity from t = {since} s: at most {ratio[worst]:.3e} at t = "
+              f"{h['time'][rows][worst]:.4f} s (tolerance {bound:.1e}), {int(np.sum(rows))} rows")
+        if not ratio[worst] <= bound:
+            print("FAILED: the kinetic energy rose again after the heap had settled")
+            failed = True
 sys.exit(1 if failed else 0)
