@@ -79,6 +79,7 @@ namespace mpm
             p.copy_to(given, &home_cells, new_labels.get());
             convert_points(given, points);
           }
+        put_in_cell_order(*new_labels);
         labels = std::move(new_labels); // a snapshot being written keeps the old ones
         // New points: the scatter's slabs are built anew for them, as in a new engine (a
         // run resumed from a checkpoint then sums in the order of the run that wrote it).
@@ -87,10 +88,46 @@ namespace mpm
           refresh_active_nodes();
       }
 
+      // Several ranks: the points by lattice cell, by id within a cell, whatever order the
+      // handler gave them in. The handler lists cells by their index in deal.II's
+      // triangulation, and a cell's index depends on the partitions the grid went through (p4est
+      // coarsens the cells a rank no longer sees and refines them anew when it does): a run
+      // resumed from a checkpoint would hold the same points in another order and sum them in
+      // another order. handler_index maps the engine's order back to the handler's for store().
+      void put_in_cell_order(PointLabels<dim> &new_labels)
+      {
+        handler_index.clear();
+        if (shared_grid == nullptr)
+          return;
+        const int n = points.size();
+        handler_index.resize(n);
+        for (int i = 0; i < n; ++i)
+          handler_index[i] = i;
+        std::sort(handler_index.begin(), handler_index.end(), [&](const int a, const int b) {
+          return home_cells[a] != home_cells[b] ? home_cells[a] < home_cells[b] :
+                                                  new_labels.id[a] < new_labels.id[b];
+        });
+        for_each_point_array<dim>(points, points, [&](auto &array, auto &) { gather(array, handler_index); });
+        gather(home_cells, handler_index);
+        gather(new_labels.id, handler_index);
+        for (int d = 0; d < dim; ++d)
+          gather(new_labels.initial_position[d], handler_index);
+      }
+
+      // array[k] <- array[order[k]]
+      template <typename Array>
+      static void gather(Array &array, const std::vector<int> &order)
+      {
+        const Array copy = array;
+        for (std::size_t k = 0; k < order.size(); ++k)
+          array[k] = copy[order[k]];
+      }
+
       void load(const HostPoints<dim, double> &p, std::shared_ptr<const PointLabels<dim>> new_labels) override
       {
         convert_points(p, points);
         home_cells.clear(); // asked for on several ranks (loaded from the handler) and below
+        handler_index.clear();
         labels = std::move(new_labels);
         backend.forget_grouping();
         if (this->follows_material())
@@ -135,7 +172,19 @@ namespace mpm
       unsigned int store(MaterialPoints<dim> &p) override
       {
         unsigned int removed;
-        if constexpr (std::is_same_v<Real, double>)
+        if (!handler_index.empty())
+          {
+            // back in the handler's order (put_in_cell_order)
+            HostPoints<dim, double> wide;
+            convert_points(points, wide);
+            for_each_point_array<dim>(wide, wide, [&](auto &array, auto &) {
+              const auto copy = array;
+              for (std::size_t k = 0; k < handler_index.size(); ++k)
+                array[handler_index[k]] = copy[k];
+            });
+            removed = p.copy_from(wide);
+          }
+        else if constexpr (std::is_same_v<Real, double>)
           removed = p.copy_from(points);
         else
           {
@@ -311,6 +360,7 @@ namespace mpm
       CpuBackend                              backend;
       HostPoints<dim, Real>                   points;
       std::vector<long>                       home_cells; // lattice cell of each point at the last sort
+      std::vector<int>                        handler_index; // several ranks: point k is the handler's handler_index[k]
       std::shared_ptr<const PointLabels<dim>> labels;     // id, initial position, in the order of points
     };
   } // namespace
