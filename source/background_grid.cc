@@ -143,12 +143,56 @@ namespace mpm
               ++points_in_cell[lattice_cell_of(x)];
             }
         const double point_weight = parameters.point_weight;
+        using CellIterator        = typename dealii::Triangulation<dim>::cell_iterator;
         using CellStatus          = typename dealii::Triangulation<dim>::CellStatus;
-        weights                   = triangulation.signals.weight.connect(
-          [&points_in_cell, point_weight, this](const typename dealii::Triangulation<dim>::cell_iterator &cell,
-                                                const CellStatus) -> unsigned int {
-            const dealii::Point<dim> center = cell->center();
-            return cell_partition_weight(points_in_cell[lattice_cell_of(&center[0])], point_weight);
+        // p4est partitions after each level of refine_global. deal.II asks for the weights of a
+        // refined cell's children one after the other, handing over the parent (the children
+        // do not exist yet; deal.II 9.4 says CELL_REFINE for the first child and CELL_INVALID
+        // for the others): child k is the parent's k-th corner, bit d of k set for the upper
+        // half in direction d. Each gets the mean work of the lattice cells it covers (at the
+        // last level its own cell's; before, proportional to their sum without overflowing
+        // p4est's int weights). Every child given the lattice cell at the parent's centre, as
+        // before, left the build's partition unlike the repartition's (doc/log.md, 2026-12-02).
+        weights = triangulation.signals.weight.connect(
+          [&points_in_cell, point_weight, this, parent = std::pair<int, int>(-1, -1), next_child = 0u](
+            const CellIterator &cell, const CellStatus status) mutable -> unsigned int {
+            dealii::Point<dim> lower = cell->vertex(0), upper = cell->vertex(dealii::GeometryInfo<dim>::vertices_per_cell - 1);
+            if (status == dealii::Triangulation<dim>::CELL_REFINE || status == dealii::Triangulation<dim>::CELL_INVALID)
+              {
+                if (std::make_pair(cell->level(), cell->index()) != parent)
+                  {
+                    parent     = {cell->level(), cell->index()};
+                    next_child = 0;
+                  }
+                const unsigned int k = next_child++ % dealii::GeometryInfo<dim>::max_children_per_cell;
+                for (int d = 0; d < dim; ++d)
+                  {
+                    const double middle = 0.5 * (lower[d] + upper[d]);
+                    (k >> d & 1 ? lower[d] : upper[d]) = middle;
+                  }
+              }
+            long first[dim], count[dim], n = 1;
+            for (int d = 0; d < dim; ++d)
+              {
+                first[d] = std::lround((lower[d] - origin[d]) / h);
+                count[d] = std::max(1L, std::lround((upper[d] - lower[d]) / h));
+                n *= count[d];
+              }
+            double points = 0;
+            for (long j = 0; j < n; ++j)
+              {
+                long index = 0, rest = j;
+                long at[dim];
+                for (int d = 0; d < dim; ++d)
+                  {
+                    at[d] = first[d] + rest % count[d];
+                    rest /= count[d];
+                  }
+                for (int d = dim - 1; d >= 0; --d)
+                  index = index * n_cells[d] + at[d];
+                points += points_in_cell[index];
+              }
+            return cell_partition_weight(points / n, point_weight);
           });
       }
     triangulation.refine_global(levels);

@@ -97,7 +97,7 @@ namespace mpm
       void put_in_cell_order(PointLabels<dim> &new_labels)
       {
         handler_index.clear();
-        if (shared_grid == nullptr)
+        if (shared_grid == nullptr || shared_grid->n_ranks == 1) // one rank: one grid's history
           return;
         const int n = points.size();
         handler_index.resize(n);
