@@ -90,10 +90,10 @@ namespace mpm
 
       // Several ranks: the points by lattice cell, by id within a cell, whatever order the
       // handler gave them in. The handler lists cells by their index in deal.II's
-      // triangulation, and a cell's index depends on the partitions the grid went through (p4est
-      // coarsens the cells a rank no longer sees and refines them anew when it does): a run
-      // resumed from a checkpoint would hold the same points in another order and sum them in
-      // another order. handler_index maps the engine's order back to the handler's for store().
+      // triangulation, which depends on the partitions the grid went through: a run resumed
+      // from a checkpoint held the same points in another order and summed them in another
+      // order (doc/log.md, 2026-12-02). handler_index maps the engine's order back to the
+      // handler's for store().
       void put_in_cell_order(PointLabels<dim> &new_labels)
       {
         handler_index.clear();
