@@ -147,8 +147,9 @@ namespace mpm
         using CellStatus          = typename dealii::Triangulation<dim>::CellStatus;
         // p4est partitions after each level of refine_global. deal.II asks for the weights of a
         // refined cell's children one after the other, handing over the parent (the children
-        // do not exist yet; deal.II 9.4 says CELL_REFINE for the first child and CELL_INVALID
-        // for the others): child k is the parent's k-th corner, bit d of k set for the upper
+        // do not exist yet). In deal.II 9.4 the first child comes with CELL_REFINE, the others
+        // with CELL_INVALID (taking both as children is what makes test_build_partition find
+        // no cell moved). Child k is the parent's k-th corner, bit d of k set for the upper
         // half in direction d. Each gets the mean work of the lattice cells it covers (at the
         // last level its own cell's; before, proportional to their sum without overflowing
         // p4est's int weights). Every child given the lattice cell at the parent's centre, as
@@ -156,8 +157,10 @@ namespace mpm
         weights = triangulation.signals.weight.connect(
           [&points_in_cell, point_weight, this, parent = std::pair<int, int>(-1, -1), next_child = 0u](
             const CellIterator &cell, const CellStatus status) mutable -> unsigned int {
-            dealii::Point<dim> lower = cell->vertex(0), upper = cell->vertex(dealii::GeometryInfo<dim>::vertices_per_cell - 1);
-            if (status == dealii::Triangulation<dim>::CELL_REFINE || status == dealii::Triangulation<dim>::CELL_INVALID)
+            constexpr unsigned int last_vertex = dealii::GeometryInfo<dim>::vertices_per_cell - 1;
+            dealii::Point<dim>     lower = cell->vertex(0), upper = cell->vertex(last_vertex);
+            if (status == dealii::Triangulation<dim>::CELL_REFINE ||
+                status == dealii::Triangulation<dim>::CELL_INVALID)
               {
                 if (std::make_pair(cell->level(), cell->index()) != parent)
                   {
