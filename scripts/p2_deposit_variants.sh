@@ -33,6 +33,14 @@ declare -A solver=(
   set Local damping = 0"
   [cpgimp_u_hencky_no_damping]="set GIMP domain update = U
   set Local damping = 0"
+  [flip_change]="set FLIP at fixed nodes = velocity change"
+  [flip_change_no_damping]="set FLIP at fixed nodes = velocity change
+  set Local damping = 0"
+  [flip_change_no_damping_0995]="set FLIP at fixed nodes = velocity change
+  set Local damping = 0
+  set FLIP fraction = 0.995"
+  [flip_1_change]="set FLIP at fixed nodes = velocity change
+  set FLIP fraction = 1"
 )
 declare -A material=([cpgimp_u_hencky_no_damping]="set Elastic law = Hencky")
 declare -A boundary=([free_slip_base]="set z min = free-slip")

@@ -195,6 +195,13 @@ namespace mpm
     prm.declare_entry("FLIP fraction", "1", Patterns::Double(0, 1),
                       "Velocity update: 1 = pure FLIP, 0 = pure PIC, in between a blend. Not used with "
                       "Velocity transfer = APIC or TPIC.");
+    prm.declare_entry("FLIP at fixed nodes", "no change", Patterns::Selection("no change|velocity change"),
+                      "What FLIP passes to the points from a node component that a boundary holds fixed (a "
+                      "no-slip base, a roller's normal). no change (ep2-3De's): nothing, so a point beside a "
+                      "no-slip base keeps the velocity it had while the base stops it (with pure FLIP a settled "
+                      "heap keeps points at rest with FLIP velocities up to 0.8 m/s; doc/methods.md). velocity "
+                      "change: the change the boundary made, from the node's velocity before the update to zero, as "
+                      "at every other node. Not used with Velocity transfer = APIC or TPIC (PIC's velocity).");
     prm.declare_entry("Velocity transfer", "FLIP/PIC blend", Patterns::Selection("FLIP/PIC blend|APIC|TPIC"),
                       "FLIP/PIC blend: the points' velocities by FLIP fraction. APIC and TPIC: each point also "
                       "carries an affine velocity matrix C (output as the fields apic_C_xx, apic_C_xy, ...), its "
@@ -541,6 +548,7 @@ namespace mpm
                                                                   : LocalDampingForm::per_component;
     damping_threshold = prm.get_double("Local damping threshold");
     flip_fraction     = prm.get_double("FLIP fraction");
+    flip_fixed_velocity_change = prm.get("FLIP at fixed nodes") == "velocity change";
     const std::string transfer = prm.get("Velocity transfer");
     apic                       = transfer == "APIC" || transfer == "TPIC";
     affine_matrix = transfer == "APIC" ? AffineMatrix::b_d_inverse : AffineMatrix::velocity_gradient;

@@ -531,6 +531,7 @@ namespace mpm
       settings.damping_form       = parameters.damping_form;
       settings.damping_threshold  = parameters.damping_threshold;
       settings.flip_fraction      = parameters.flip_fraction;
+      settings.flip_fixed_velocity_change = parameters.flip_fixed_velocity_change;
       settings.affine_state_variable = parameters.affine_state_variable();
       settings.affine_matrix         = parameters.affine_matrix;
       settings.corner_state_variable = parameters.corner_state_variable();

@@ -104,6 +104,7 @@ namespace mpm_test
   // held: the equilibration's steps instead (StepSettings::hold_points, the grid keeping its
   // velocities from the second step on, damping 0.8, PIC, the Courant number bounded by the
   // points' domains as in the equilibration).
+  // flip_fixed_velocity_change: FLIP passes the no-slip base's velocity change to the points.
   // floor_at_face: the base is the grid's face y = 0, a frictional wall (mu = 0.3) that stops
   // the points' centres (StepSettings::wall_faces), with FLIP 0.99 and pressure averaging as in
   // V3's prm (the flow carries centres through this floor where the wall does not stop them,
@@ -112,7 +113,7 @@ namespace mpm_test
   SceneResult collapse(mpm::HostPoints<2, double> &points, const long n_steps,
                        const mpm::HostPoints<2, double> *initial = nullptr, const bool drucker_prager = false,
                        const bool held = false, const mpm::ElasticLaw law = mpm::ElasticLaw::jaumann_rate,
-                       const bool floor_at_face = false)
+                       const bool floor_at_face = false, const bool flip_fixed_velocity_change = false)
   {
     using namespace mpm;
     const double h = 0.005, rho = 2650, E = 0.84e6, nu = 0.3, g = 9.81;
@@ -168,6 +169,7 @@ namespace mpm_test
     s.flip_fraction  = 1.0;
     s.domain_update  = DomainUpdate::det_F;
     s.mass_tolerance = 1e-12 * points.mass[0];
+    s.flip_fixed_velocity_change = flip_fixed_velocity_change;
     if (held)
       {
         s.hold_points   = true;

@@ -174,6 +174,20 @@ int main()
         report<2>("V3 collapse, DP, GPU sorted every 7", compare_points(cpu, gpu, 0.005), spread, n, true);
       }
       {
+        // The same with Solver/FLIP at fixed nodes = velocity change: the no-slip base's fixed
+        // nodes pass FLIP the change to zero of the velocity they had (update_grid)
+        const long            n = 600;
+        HostPoints<2, double> cpu, gpu, initial;
+        collapse<CpuTarget>(initial, 0, nullptr, true);
+        collapse<CpuTarget>(cpu, n, &initial, true, false, ElasticLaw::jaumann_rate, false, true);
+        const Difference spread = cpu_reordering_spread(initial, cpu, 0.005, [&](auto &out, const auto *start) {
+          collapse<CpuTarget>(out, n, start, true, false, ElasticLaw::jaumann_rate, false, true);
+        });
+        collapse<CudaTarget>(gpu, n, &initial, true, false, ElasticLaw::jaumann_rate, false, true);
+        report<2>("V3 collapse, DP, FLIP velocity change at the base", compare_points(cpu, gpu, 0.005), spread, n,
+                  true);
+      }
+      {
         // V3 with Drucker-Prager onto a frictional floor at the grid's face, which stops the
         // points' centres that the flow's front carries onto it (stop_at_walls)
         const long            n = 2500;

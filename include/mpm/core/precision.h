@@ -68,6 +68,7 @@ namespace mpm
     r.damping_form              = s.damping_form;
     r.damping_threshold         = static_cast<To>(s.damping_threshold);
     r.flip_fraction             = static_cast<To>(s.flip_fraction);
+    r.flip_fixed_velocity_change = s.flip_fixed_velocity_change;
     r.domain_update             = s.domain_update;
     r.mass_tolerance            = static_cast<To>(s.mass_tolerance);
     r.pressure_averaging        = s.pressure_averaging;

@@ -75,6 +75,11 @@ namespace mpm
     LocalDampingForm damping_form = LocalDampingForm::per_component; // local_damping.h
     Real             damping_threshold = Real(0); // nodal speeds at or below it are not damped
     Real         flip_fraction  = Real(1);            // 1: pure FLIP, 0: pure PIC
+    // FLIP at a node component that a boundary holds fixed. false (ep2-3De's): no velocity
+    // change reaches the points, so a point beside a no-slip base keeps a velocity it does not
+    // move with. true: the change the boundary made, from the node's velocity before the
+    // update to zero, as at every other node.
+    bool         flip_fixed_velocity_change = false;
     DomainUpdate domain_update  = DomainUpdate::none; // uGIMP or cpGIMP variants
     Real         mass_tolerance = Real(0);            // nodes lighter than this carry no velocity
     // Cell-wise volume-weighted pressure averaging after the constitutive update
@@ -624,13 +629,18 @@ namespace mpm
         Real v_old[dim];
         if (faces != 0)
           for (int d = 0; d < dim; ++d)
-            v_old[d] = (g.fixed_components[n] >> d) & 1u ? Real(0) : velocity_before(d);
+            v_old[d] = (g.fixed_components[n] >> d) & 1u && !s.flip_fixed_velocity_change ? Real(0)
+                                                                                           : velocity_before(d);
         for (int d = 0; d < dim; ++d)
           {
             const bool fixed = (g.fixed_components[n] >> d) & 1u;
             if (m <= s.mass_tolerance || fixed)
               {
-                g.momentum[d][n] = g.force[d][n] = g.velocity[d][n] = Real(0);
+                // FLIP's share of the boundary's change to zero (PIC's share is zero).
+                g.force[d][n] = m > s.mass_tolerance && s.flip_fixed_velocity_change
+                                  ? -s.flip_fraction * velocity_before(d)
+                                  : Real(0);
+                g.momentum[d][n] = g.velocity[d][n] = Real(0);
                 continue;
               }
             const Real v     = velocity_before(d);

@@ -64,6 +64,8 @@ namespace mpm
     LocalDampingForm damping_form;
     double       damping_threshold; // m/s
     double       flip_fraction;
+    // Solver/FLIP at fixed nodes = velocity change (StepSettings::flip_fixed_velocity_change)
+    bool         flip_fixed_velocity_change = false;
     // Solver/Velocity transfer = APIC or TPIC: an affine transfer, C_p in the last dim x dim state
     // variables, computed as affine_matrix says
     bool         apic          = false;
