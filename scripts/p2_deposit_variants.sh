@@ -33,6 +33,8 @@ declare -A solver=(
   set Local damping = 0"
   [cpgimp_u_hencky_no_damping]="set GIMP domain update = U
   set Local damping = 0"
+  [no_damping_0995]="set Local damping = 0
+  set FLIP fraction = 0.995"
   [flip_change]="set FLIP at fixed nodes = velocity change"
   [flip_change_no_damping]="set FLIP at fixed nodes = velocity change
   set Local damping = 0"
@@ -46,6 +48,9 @@ declare -A material=([cpgimp_u_hencky_no_damping]="set Elastic law = Hencky")
 declare -A boundary=([free_slip_base]="set z min = free-slip")
 all="default no_damping cpgimp_u cpgimp_f_ii cpgimp_det_f bspline2 flip_1 no_averaging free_slip_base cpgimp_u_no_damping"
 [ $# -gt 0 ] && all="$*"
+for name in $all; do # a misspelt name would run the prm as it is under that name
+  [ -n "${solver[$name]+x}${boundary[$name]+x}" ] || { echo "unknown variant '$name'; known: ${!solver[*]} ${!boundary[*]}"; exit 2; }
+done
 
 for name in $all; do
   dir=$out/$name prm=$out/$name.prm

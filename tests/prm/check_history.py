@@ -33,6 +33,8 @@ parser.add_argument("--at-rest", type=float)
 parser.add_argument("--at-rest-after")
 args = parser.parse_args()
 
+if not os.path.isfile(os.path.join(args.output_dir, "history.csv")):
+    sys.exit(f"FAILED: no history.csv in {args.output_dir} (did the run start?)")
 h = mpm_results.history(args.output_dir)
 failed = False
 if args.finite:
