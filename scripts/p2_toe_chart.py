@@ -39,8 +39,10 @@ def label(r):
 ax.set_yticklabels([label(r) for r in reversed(rows)], fontsize=8)
 ax.set_xlim(0.35, 0.68)
 ax.set_xlabel("toe: 99.9th percentile of x at t = 1 s (m)")
-ax.set_title(f"P2, 512,000 points, Backend = cuda: the toe against the method\n({rows[0]['machine']}, {rows[0]['date']}; "
-             f"marked rows: {rows[-1]['machine'].split('(')[0].strip()}, {rows[-1]['date']})",
+marked = [r for r in rows if r["machine"] != rows[0]["machine"]]
+dates = sorted({r["date"] for r in marked})
+ax.set_title(f"P2, 512,000 points, Backend = cuda: the toe against the method\n({rows[0]['machine']}, {rows[0]['date']}"
+             + (f"; marked rows: {marked[-1]['machine'].split('(')[0].strip()}, {', '.join(dates)})" if marked else ")"),
              fontsize=9)
 ax.legend(loc="lower right", fontsize=7)
 fig.tight_layout()
