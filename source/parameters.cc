@@ -201,7 +201,9 @@ namespace mpm
                       "no-slip base keeps the velocity it had while the base stops it (with pure FLIP a settled "
                       "heap keeps points at rest with FLIP velocities up to 0.8 m/s; doc/methods.md). velocity "
                       "change: the change the boundary made, from the node's velocity before the update to zero, as "
-                      "at every other node. Not used with Velocity transfer = APIC or TPIC (PIC's velocity).");
+                      "at every other node: the heap at rest loses those velocities; with pure FLIP it moves the "
+                      "noise between points instead (warned of: use it with FLIP fraction 0.99-0.995). Not used "
+                      "with Velocity transfer = APIC or TPIC (PIC's velocity).");
     prm.declare_entry("Velocity transfer", "FLIP/PIC blend", Patterns::Selection("FLIP/PIC blend|APIC|TPIC"),
                       "FLIP/PIC blend: the points' velocities by FLIP fraction. APIC and TPIC: each point also "
                       "carries an affine velocity matrix C (output as the fields apic_C_xx, apic_C_xy, ...), its "
