@@ -43,8 +43,19 @@ declare -A solver=(
   set FLIP fraction = 0.995"
   [flip_1_change]="set FLIP at fixed nodes = velocity change
   set FLIP fraction = 1"
+  [disconnect]=""
+  [flip_1_disconnect]="set FLIP fraction = 1"
+  [flip_1_change_disconnect]="set FLIP at fixed nodes = velocity change
+  set FLIP fraction = 1"
+  [flip_change_no_damping_0995_disconnect]="set FLIP at fixed nodes = velocity change
+  set Local damping = 0
+  set FLIP fraction = 0.995"
 )
-declare -A material=([cpgimp_u_hencky_no_damping]="set Elastic law = Hencky")
+declare -A material=([cpgimp_u_hencky_no_damping]="set Elastic law = Hencky"
+  [disconnect]="set Disconnection volume ratio = 2"
+  [flip_1_disconnect]="set Disconnection volume ratio = 2"
+  [flip_1_change_disconnect]="set Disconnection volume ratio = 2"
+  [flip_change_no_damping_0995_disconnect]="set Disconnection volume ratio = 2")
 declare -A boundary=([free_slip_base]="set z min = free-slip")
 all="default no_damping cpgimp_u cpgimp_f_ii cpgimp_det_f bspline2 flip_1 no_averaging free_slip_base cpgimp_u_no_damping"
 [ $# -gt 0 ] && all="$*"

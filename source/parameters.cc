@@ -266,6 +266,14 @@ namespace mpm
                           "model's return mapping in principal logarithmic strains (doc/theory-plasticity.md). The "
                           "two agree at small strain. Both backends; not with models defined outside the "
                           "library.");
+        prm.declare_entry("Disconnection volume ratio", "0", Patterns::Double(0),
+                          "A point whose volume exceeds this multiple of its initial volume has lost contact "
+                          "(a granular material's disconnected phase): it carries no stress and takes no part "
+                          "in the pressure averaging, and compacted back below the ratio its stress starts again "
+                          "from zero. Keeps points that a thin front has dilated to many times their volume from "
+                          "taking a recompression's stress on that whole volume (doc/methods.md, \"Disconnected "
+                          "points\"). 0 (the default): never; otherwise a ratio > 1, e.g. 2. The MPM step only "
+                          "(not the FEM stage).");
         for (const auto &[model, plugin] : material_library())
           {
             prm.enter_subsection(model);
@@ -605,6 +613,14 @@ namespace mpm
                                                         "the library and gets only strain and spin increments.");
             materials.back().elastic_law = ElasticLaw::hencky;
           }
+        {
+          const double ratio = prm.get_double("Disconnection volume ratio");
+          if (ratio != 0 && !(ratio > 1))
+            fail("Material " + name + "/Disconnection volume ratio",
+                 "must be 0 (never) or a ratio of volumes greater than 1; got " + prm.get("Disconnection volume ratio") +
+                   ".");
+          materials.back().disconnection_volume_ratio = ratio;
+        }
         if (const UserConstitutiveModel *user = materials.back().user_model)
           {
             const std::vector<StateVariable> variables = user->state_variables();

@@ -537,6 +537,9 @@ namespace mpm
       settings.corner_state_variable = parameters.corner_state_variable();
       settings.domain_update      = parameters.domain_update;
       settings.pressure_averaging = parameters.pressure_averaging;
+      settings.disconnected_points =
+        std::any_of(parameters.materials.begin(), parameters.materials.end(),
+                    [](const MaterialParameters<double> &m) { return m.disconnection_volume_ratio > 0; });
       settings.mass_tolerance     = 1e-12 * m_min; // nodes lighter than that carry no velocity
       settings.wall_faces         = 0;
       for (unsigned int id = 0; id < 2 * dim; ++id)

@@ -426,6 +426,16 @@ namespace mpm
         return false;
       }
 
+      // Whether a material of the table disconnects points (material.h): the averaging
+      // finished outside a step then leaves them out, as the step does.
+      inline bool disconnects_points(const std::vector<MaterialParameters<double>> &materials)
+      {
+        for (const MaterialParameters<double> &m : materials)
+          if (m.disconnection_volume_ratio > 0)
+            return true;
+        return false;
+      }
+
       // The step's exchange hook: nothing on one rank, the NodalExchange through the
       // staging buffers otherwise, in the engine's type Real.
       template <typename Real>
@@ -518,6 +528,8 @@ namespace mpm
       ShapeFunction                shape;
       // A material asks for Hencky's law: the step runs the kernels that hold it.
       bool                         hencky = false;
+      // A material disconnects points (disconnects_points).
+      bool                         disconnects = false;
       Staging<int, Real>           exchanged_nodes;
       Staging<long, Real>          exchanged_cells;
       ExchangeAdapter<Real>        exchange;
@@ -592,7 +604,7 @@ namespace mpm
       {
         if (averaging_pending)
           {
-            stages::finish_pressure_averaging(backend, view(), points.view());
+            stages::finish_pressure_averaging(backend, view(), points.view(), disconnects ? materials.data() : nullptr);
             averaging_pending = false;
           }
       }
@@ -678,7 +690,8 @@ namespace mpm
         }
       impl->grid.set_box(slab_lower, slab_nodes);
       impl->materials.upload(converted<Real>(materials));
-      impl->hencky = uses_hencky(materials);
+      impl->hencky      = uses_hencky(materials);
+      impl->disconnects = disconnects_points(materials);
       impl->exchange = ExchangeAdapter<Real>{exchange, &impl->backend, &impl->exchanged_nodes, &impl->exchanged_cells};
       if (exchange != nullptr)
         {
@@ -869,7 +882,8 @@ namespace mpm
     {
       impl->backend.synchronize(); // the table may be in use by a launch in flight
       impl->materials.upload(converted<Real>(materials));
-      impl->hencky = uses_hencky(materials);
+      impl->hencky      = uses_hencky(materials);
+      impl->disconnects = disconnects_points(materials);
     }
 
     template <int dim, typename Real>

@@ -109,11 +109,13 @@ namespace mpm_test
   // the points' centres (StepSettings::wall_faces), with FLIP 0.99 and pressure averaging as in
   // V3's prm (the flow carries centres through this floor where the wall does not stop them,
   // tests/core/test_wall_friction).
+  // disconnection_volume_ratio: the material's (material.h, disconnected points).
   template <template <int, typename> class Target>
   SceneResult collapse(mpm::HostPoints<2, double> &points, const long n_steps,
                        const mpm::HostPoints<2, double> *initial = nullptr, const bool drucker_prager = false,
                        const bool held = false, const mpm::ElasticLaw law = mpm::ElasticLaw::jaumann_rate,
-                       const bool floor_at_face = false, const bool flip_fixed_velocity_change = false)
+                       const bool floor_at_face = false, const bool flip_fixed_velocity_change = false,
+                       const double disconnection_volume_ratio = 0)
   {
     using namespace mpm;
     const double h = 0.005, rho = 2650, E = 0.84e6, nu = 0.3, g = 9.81;
@@ -158,7 +160,8 @@ namespace mpm_test
         m.drucker_prager.strength.friction_angle  = 19.8 * 3.14159265358979323846 / 180;
         m.drucker_prager.strength.residual_friction_angle = m.drucker_prager.strength.friction_angle;
       }
-    m.elastic_law  = law;
+    m.elastic_law                = law;
+    m.disconnection_volume_ratio = disconnection_volume_ratio;
     const double c = std::sqrt(m.elastic.p_wave_modulus() / rho);
 
     StepSettings<2, double> s;
@@ -170,6 +173,7 @@ namespace mpm_test
     s.domain_update  = DomainUpdate::det_F;
     s.mass_tolerance = 1e-12 * points.mass[0];
     s.flip_fixed_velocity_change = flip_fixed_velocity_change;
+    s.disconnected_points        = disconnection_volume_ratio > 0;
     if (held)
       {
         s.hold_points   = true;

@@ -42,6 +42,7 @@ namespace mpm
     r.plasticity_enabled              = m.plasticity_enabled;
     r.field_parameter                 = m.field_parameter;
     r.elastic_law                     = m.elastic_law;
+    r.disconnection_volume_ratio      = static_cast<To>(m.disconnection_volume_ratio);
     r.user_model                      = m.user_model; // runs in double only (the caller refuses float)
     return r;
   }
@@ -72,6 +73,7 @@ namespace mpm
     r.domain_update             = s.domain_update;
     r.mass_tolerance            = static_cast<To>(s.mass_tolerance);
     r.pressure_averaging        = s.pressure_averaging;
+    r.disconnected_points       = s.disconnected_points;
     r.hold_points               = s.hold_points;
     r.hold_from_point_momentum  = s.hold_from_point_momentum;
     r.affine_state_variable     = s.affine_state_variable;

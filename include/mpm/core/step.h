@@ -85,6 +85,10 @@ namespace mpm
     // Cell-wise volume-weighted pressure averaging after the constitutive update
     // (remedy for volumetric locking); needs the grid's cell arrays.
     bool pressure_averaging = false;
+    // Some material disconnects points (MaterialParameters::disconnection_volume_ratio): the
+    // averaging then leaves out the points that have (their volume, zero pressure and the
+    // cell's mean). false: it never looks at the materials.
+    bool disconnected_points = false;
     // The points hold their place and shape (position, F, volume, GIMP domain): only their
     // stresses follow the grid's velocities. The equilibration of an initial state uses it,
     // so that the MPM's equilibrium is found in the geometry handed over.
@@ -356,6 +360,24 @@ namespace mpm
       return g.cell_pressure_volume[c] / g.cell_volume[c] - mean;
     }
 
+    // Whether point i (not removed) takes part in the pressure averaging: not where it is
+    // disconnected (material.h), since a point that has lost contact has no pressure to share
+    // and takes none. disconnecting: the materials, or null where none disconnects
+    // (StepSettings::disconnected_points).
+    template <int dim, typename Real>
+    MPM_HOST_DEVICE inline bool averages_pressure(const MaterialParameters<Real> *disconnecting,
+                                                  const PointsView<dim, Real> &p, const int i)
+    {
+      return disconnecting == nullptr ||
+             !disconnected(disconnecting[p.material[i]], p.volume[i] / p.initial_volume[i]);
+    }
+    template <int dim, typename Real>
+    inline const MaterialParameters<Real> *disconnecting_materials(const StepSettings<dim, Real> &s,
+                                                                   const MaterialParameters<Real> *materials)
+    {
+      return s.disconnected_points ? materials : nullptr;
+    }
+
     // APIC's D_p / h^2 for a shape function (Jiang et al. 2015), 0 where it has none constant.
     template <typename Shape>
     MPM_HOST_DEVICE constexpr double apic_inertia_over_h2()
@@ -472,7 +494,8 @@ namespace mpm
                            const bool                        mass_and_momentum,
                            const bool                        forces,
                            void                             *stencils = nullptr,
-                           const bool                        apply_averaging = false)
+                           const bool                        apply_averaging = false,
+                           const MaterialParameters<Real>   *disconnecting = nullptr)
     {
       backend.scatter_points(p.n_points, [=] MPM_HOST_DEVICE(const int i) {
         if (p.material[i] < 0)
@@ -488,7 +511,7 @@ namespace mpm
         SymTensor<Real> sigma;
         for (int c = 0; c < n_voigt; ++c)
           sigma[c] = p.stress[c][i];
-        if (apply_averaging) // the last step's, left pending (explicit_step)
+        if (apply_averaging && averages_pressure(disconnecting, p, i)) // the last step's, left pending (explicit_step)
           {
             const Real shift = cell_pressure_shift(g, x, sigma[0], sigma[1], sigma[2]);
             for (int k = 0; k < 3; ++k)
@@ -819,8 +842,10 @@ namespace mpm
     // cell's sums.
     template <typename Backend, int dim, typename Real>
     MPM_HOST_DEVICE inline void add_cell_pressure(const GridView<dim, Real> &g, const PointsView<dim, Real> &p,
-                                                  const int i)
+                                                  const int i, const MaterialParameters<Real> *disconnecting)
     {
+      if (!averages_pressure(disconnecting, p, i))
+        return;
       Real        mean;
       const int   c          = cell_and_mean_stress(g, p, i, mean);
       if (c < 0) // a cell whose sums are not kept (nodes near the material: the run stops after the step)
@@ -835,10 +860,11 @@ namespace mpm
     // atomic (grid_to_particle_kinematics refuses the others before it starts).
     template <typename Backend, int dim, typename Real>
     MPM_HOST_DEVICE inline void add_cell_pressure_atomically(const GridView<dim, Real> &g,
-                                                             const PointsView<dim, Real> &p, const int i)
+                                                             const PointsView<dim, Real> &p, const int i,
+                                                             const MaterialParameters<Real> *disconnecting)
     {
       if constexpr (atomic_scatter<Backend>::value)
-        add_cell_pressure<Backend>(g, p, i);
+        add_cell_pressure<Backend>(g, p, i, disconnecting);
     }
 
     // G2P kinematics from the nodal velocity field, then per point: position,
@@ -860,6 +886,7 @@ namespace mpm
       if constexpr (!atomic_scatter<Backend>::value)
         if (scatter_pressure)
           throw std::invalid_argument("grid_to_particle_kinematics: this backend scatters only in scatter_points");
+      const MaterialParameters<Real> *disconnecting = disconnecting_materials(s, materials);
       backend.gather_points(p.n_points, [=] MPM_HOST_DEVICE(const int i) {
         if (p.material[i] < 0)
           return;
@@ -1014,7 +1041,7 @@ namespace mpm
         if (leaves_grid)
           p.material[i] = -1;
         else if (scatter_pressure)
-          add_cell_pressure_atomically<Backend>(g, p, i);
+          add_cell_pressure_atomically<Backend>(g, p, i, disconnecting);
       });
     }
 
@@ -1063,13 +1090,14 @@ namespace mpm
     // two passes.
     template <int dim, typename Real, typename Backend, typename Exchange = NoGridExchange>
     void scatter_cell_pressure(Backend &backend, const GridView<dim, Real> &g, const PointsView<dim, Real> &p,
-                               const Exchange &exchange = Exchange())
+                               const Exchange &exchange = Exchange(),
+                               const MaterialParameters<Real> *disconnecting = nullptr)
     {
       if (g.cell_volume == nullptr || g.cell_pressure_volume == nullptr)
         throw std::invalid_argument("pressure averaging needs GridView::cell_volume and cell_pressure_volume");
       backend.scatter_points(p.n_points, [=] MPM_HOST_DEVICE(const int i) {
         if (p.material[i] >= 0)
-          add_cell_pressure<Backend>(g, p, i);
+          add_cell_pressure<Backend>(g, p, i, disconnecting);
       });
       // MPI: a cell near a partition boundary holds points of two ranks (a point that has
       // not migrated yet sits less than a cell outside its home cell): sum over ranks.
@@ -1080,8 +1108,10 @@ namespace mpm
     // The gather of the averaging for point i (not removed).
     template <int dim, typename Real>
     MPM_HOST_DEVICE inline void apply_cell_pressure(const GridView<dim, Real> &g, const PointsView<dim, Real> &p,
-                                                    const int i)
+                                                    const int i, const MaterialParameters<Real> *disconnecting)
     {
+      if (!averages_pressure(disconnecting, p, i))
+        return;
       Real x[dim];
       for (int d = 0; d < dim; ++d)
         x[d] = p.position[d][i];
@@ -1094,23 +1124,25 @@ namespace mpm
     // and a pending one (explicit_step's deferred averaging) before the stresses are read
     // outside the step.
     template <int dim, typename Real, typename Backend>
-    void finish_pressure_averaging(Backend &backend, const GridView<dim, Real> &g, const PointsView<dim, Real> &p)
+    void finish_pressure_averaging(Backend &backend, const GridView<dim, Real> &g, const PointsView<dim, Real> &p,
+                                   const MaterialParameters<Real> *disconnecting = nullptr)
     {
       backend.gather_points(p.n_points, [=] MPM_HOST_DEVICE(const int i) {
         if (p.material[i] >= 0)
-          apply_cell_pressure(g, p, i);
+          apply_cell_pressure(g, p, i, disconnecting);
       });
     }
 
     // Both passes, cell sums zeroed first (USF, whose averaging is not the step's last pass).
     template <int dim, typename Real, typename Backend, typename Exchange = NoGridExchange>
     void average_cell_pressure(Backend &backend, const GridView<dim, Real> &g, const PointsView<dim, Real> &p,
-                               const Exchange &exchange = Exchange())
+                               const Exchange &exchange = Exchange(),
+                               const MaterialParameters<Real> *disconnecting = nullptr)
     {
       const int n_cells = cell_sums_to_zero(g, true);
       backend.for_each_node(n_cells, [=] MPM_HOST_DEVICE(const int c) { zero_cell_sums_then_is_node(g, c, n_cells); });
-      scatter_cell_pressure(backend, g, p, exchange);
-      finish_pressure_averaging(backend, g, p);
+      scatter_cell_pressure(backend, g, p, exchange, disconnecting);
+      finish_pressure_averaging(backend, g, p, disconnecting);
     }
 
     // The step's reductions (largest speed, power of gravity). With apply_averaging, the
@@ -1118,14 +1150,15 @@ namespace mpm
     // the per-point function exactly once per point): one pass over the points less.
     template <int dim, typename Real, typename Backend>
     StepReduction<Real> reduce_step(Backend &backend, const GridView<dim, Real> &g, const PointsView<dim, Real> &p,
-                                    const StepSettings<dim, Real> &s, const bool apply_averaging = false)
+                                    const StepSettings<dim, Real> &s, const bool apply_averaging = false,
+                                    const MaterialParameters<Real> *disconnecting = nullptr)
     {
       StepReduction<Real> init{Real(0), Real(0), Real(0)};
       return backend.reduce_points(
         p.n_points, init,
         [=] MPM_HOST_DEVICE(const int i) {
           if (apply_averaging && p.material[i] >= 0)
-            apply_cell_pressure(g, p, i);
+            apply_cell_pressure(g, p, i, disconnecting);
           StepReduction<Real> r{Real(0), Real(0), Real(0)};
           Real v2 = Real(0);
           for (int d = 0; d < dim; ++d)
@@ -1214,6 +1247,7 @@ namespace mpm
     // backend's scatter is atomic (one pass over the points less); its second pass below
     // or, deferred, in the next P2G.
     const bool scatter_in_kinematics = s.pressure_averaging && atomic_scatter<Backend>::value;
+    const MaterialParameters<Real> *disconnecting = disconnecting_materials(s, materials);
     auto       scatter_averaged_pressure = [&]() {
       if (!s.pressure_averaging)
         return;
@@ -1224,7 +1258,7 @@ namespace mpm
           return;
         }
       group_for_scatter<dim, Shape>(backend, g, p, s); // the points have moved
-      scatter_cell_pressure(backend, g, p, exchange);
+      scatter_cell_pressure(backend, g, p, exchange, disconnecting);
     };
     // Atomic backends add the affine transfers' momentum in a pass of its own, after each P2G of
     // the momentum (add_affine_momentum).
@@ -1249,7 +1283,7 @@ namespace mpm
       pass_then_sum(
         exchange, n_first, p,
         [&](const PointsView<dim, Real> &q) {
-          particles_to_grid<dim, Shape, physics>(backend, g, q, s, true, true, stencils, apply_pending);
+          particles_to_grid<dim, Shape, physics>(backend, g, q, s, true, true, stencils, apply_pending, disconnecting);
           affine_momentum(q);
         },
         ExchangedEntries::nodes, p2g_sums, 2 * dim + 1, sum_nodal(p2g_sums, 2 * dim + 1));
@@ -1316,7 +1350,7 @@ namespace mpm
             velocity_from_momentum(backend, g, s.mass_tolerance);
           grid_to_particle_kinematics<dim, Shape, physics>(backend, g, p, materials, s, dt, false, true);
           if (s.pressure_averaging)
-            average_cell_pressure(backend, g, p, exchange);
+            average_cell_pressure(backend, g, p, exchange, disconnecting);
           particles_to_grid<dim, Shape, physics>(backend, g, p, s, false, true);
           exchange.sum_nodal(forces, dim);
           update_grid(backend, g, s, dt);
@@ -1336,7 +1370,7 @@ namespace mpm
         *averaging_pending = averaged_last;
         return reduce_step(backend, g, p, s, false);
       }
-    return reduce_step(backend, g, p, s, averaged_last);
+    return reduce_step(backend, g, p, s, averaged_last, disconnecting);
   }
 
   // Dispatch on the shape function chosen at run time.

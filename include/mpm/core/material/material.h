@@ -49,6 +49,9 @@ namespace mpm
     // only into the step's DevicePhysics::all variant (step.h), which DeviceEngine runs where a
     // material asks for it.
     ElasticLaw elastic_law = ElasticLaw::jaumann_rate;
+    // A point dilated beyond this multiple of its initial volume has lost contact and carries
+    // no stress (disconnected, below); 0: never. The MPM step's update only.
+    Real disconnection_volume_ratio = Real(0);
     // model == user_defined: the model (host memory; owned by the material library).
     const UserConstitutiveModel *user_model = nullptr;
   };
@@ -132,10 +135,27 @@ namespace mpm
       }
   }
 
+  // A granular point dilated so far that its grains have lost contact (the disconnected phase
+  // of Dunatunga and Kamrin 2015, J. Fluid Mech. 779): it carries no stress, and compacted
+  // back below the ratio its stress starts again from zero. Without it a cohesionless point
+  // dilated to hundreds of times its volume at a thin front (tension leaves it stress-free,
+  // nothing stops the growth) takes the stress of its first recompression on that whole
+  // volume, a force the size of hundreds of points' (doc/methods.md, "Disconnected points").
+  template <typename Real>
+  MPM_HOST_DEVICE inline bool disconnected(const MaterialParameters<Real> &m, const Real J)
+  {
+    return m.disconnection_volume_ratio > Real(0) && J > m.disconnection_volume_ratio;
+  }
+
   template <bool with_hencky, typename Real>
   MPM_HOST_DEVICE inline void update_stress(const MaterialParameters<Real> &m, const StepKinematics<Real> &k,
                                             MaterialPointState<Real> &state)
   {
+    if (disconnected(m, k.J_new)) // no stress, no plastic flow, no state change
+      {
+        state.stress = SymTensor<Real>::zero();
+        return;
+      }
     if constexpr (with_hencky)
       {
         if (m.elastic_law == ElasticLaw::hencky && m.model != MaterialModel::user_defined)
