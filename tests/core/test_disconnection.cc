@@ -8,7 +8,7 @@
 // - ratio 0 is the model as it was: the same path gives the sum over every increment;
 // - Drucker-Prager (c = 0) stretched: its plastic strain grows at the tension cut-off while
 //   connected and not at all beyond the ratio;
-// - the prm's allowed values are checked in the deal.II layer (prm/bad/disconnection_ratio).
+// - the prm's allowed values are checked in the deal.II layer (prm/bad/disconnection_ratio_below_one).
 #include <mpm/core/material/material.h>
 
 #include "check.h"
