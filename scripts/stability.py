@@ -39,6 +39,7 @@ METHODS = {
     "cpgimp_u": ("cpGIMP U", ["set Shape function = GIMP", "set GIMP domain update = U"]),
     "bspline2": ("quadratic B-spline", ["set Shape function = quadratic B-spline",
                                         "set GIMP domain update = none"]),
+    "bspline3": ("cubic B-spline", ["set Shape function = cubic B-spline", "set GIMP domain update = none"]),
     "ugimp_tpic": ("uGIMP, TPIC", ["set Shape function = GIMP", "set GIMP domain update = none",
                                    "set Velocity transfer = TPIC"]),
     "bspline2_apic": ("quadratic B-spline, APIC", ["set Shape function = quadratic B-spline",

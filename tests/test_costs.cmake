@@ -61,6 +61,7 @@ else()
     stability/locking/cpgimp_u_hencky 11
     stability/locking/cpdi 11
     stability/flip_noise/cpgimp_det_f 11
+    stability/flip_noise/bspline3 11
     prm/slump_v5_reduced 10
   )
 endif()
