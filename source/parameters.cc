@@ -1029,6 +1029,8 @@ namespace mpm
   {
     ParameterHandler prm;
     Parameters::declare(prm, dim, 1, {"soil"});
+    // The listing of a 3D run must read as one: a copy of it runs in the dimension it was printed for.
+    prm.set("Dimension", static_cast<long int>(dim));
     const ParameterHandler::OutputStyle s =
       style == "json" ? ParameterHandler::JSON : (style == "description" ? ParameterHandler::Description :
                                                                           ParameterHandler::PRM);
