@@ -18,8 +18,8 @@ namespace
 {
   void print_help(std::ostream &out)
   {
-    out << "dealii-mpm: explicit material point method (MUSL/USL/USF, linear or GIMP shape functions)\n"
-           "on a deal.II background grid, for elasto-plastic large deformation of soils.\n\n"
+    out << "dealii-mpm: explicit material point method (MUSL/USL/USF; linear, GIMP, B-spline and CPDI shape\n"
+           "functions) on a deal.II background grid, for elasto-plastic large deformation of soils.\n\n"
            "Usage:\n"
            "  dealii-mpm scene.prm                 run the scene described by a parameter file\n"
            "  mpirun -np N dealii-mpm scene.prm    the same on N MPI ranks\n"
@@ -123,7 +123,7 @@ int main(int argc, char **argv)
       if (parameters.prefailure.analysis != mpm::fem::Analysis::none)
         {
           AssertThrow(resume.empty(), dealii::ExcMessage("--resume: a pre-failure analysis (Pre-failure analysis/"
-                                                         "Analysis) has no checkpoints; resume the MPM run instead."));
+                                                         "Method) has no checkpoints; resume the MPM run instead."));
           mpm::fem::run_prefailure_analysis(parameters, MPI_COMM_WORLD);
         }
       else

@@ -1,5 +1,6 @@
 // Guards of a run against bad input (doc/guards.md): what include/mpm/dealii/guards.h says.
 #include <mpm/dealii/guards.h>
+#include <mpm/dealii/material_library.h>
 
 #include <deal.II/base/exceptions.h>
 #include <deal.II/base/mpi.h>
@@ -70,6 +71,7 @@ namespace mpm
       std::vector<std::string> including; // the files being read, outermost first (canonical)
       std::vector<std::string> shown;     // the same as the user wrote them
       bool                     any_set = false;
+      std::set<std::string>    set_entries; // every entry set, as its path "Section/Entry"
     };
 
     void scan_text(std::istream &input, const std::string &name, std::vector<std::string> path, TextScan &scan)
@@ -146,6 +148,7 @@ namespace mpm
               const std::string value = dealii::Utilities::trim(s.substr(s.find('=') + 1));
               for (auto p = path.rbegin(); p != path.rend(); ++p)
                 entry = *p + "/" + entry;
+              scan.set_entries.insert(entry);
               const auto key    = std::make_pair(entry, blocks.empty() ? 0u : blocks.back());
               const auto before = set_at.find(key);
               if (before != set_at.end())
@@ -246,7 +249,7 @@ namespace mpm
     std::cerr << "dealii-mpm: warning: " << (entry.empty() ? "" : "Parameter '" + entry + "': ") << text << std::endl;
   }
 
-  void check_parameter_file(const std::string &filename)
+  std::optional<std::set<std::string>> check_parameter_file(const std::string &filename)
   {
     AssertThrow(!std::filesystem::is_directory(filename),
                 ExcMessage("The parameter file '" + filename + "' is a folder, not a file. Give the scene's "
@@ -257,7 +260,7 @@ namespace mpm
                            "scene's parameter file: dealii-mpm scene.prm."));
     const std::string ending = filename.substr(filename.find_last_of('.') + 1);
     if (ending != "prm" && ending != "PRM")
-      return; // .xml, .json: deal.II reads them whole; other endings it refuses itself
+      return std::nullopt; // .xml, .json: deal.II reads them whole; other endings it refuses itself
     std::ifstream in(filename);
     TextScan      scan;
     std::error_code error;
@@ -269,13 +272,67 @@ namespace mpm
                            "comments, and would run the default scene. Give the scene's entries as 'set NAME = "
                            "VALUE' lines in their subsections (dealii-mpm --print-parameters 2 prints every entry "
                            "with its default)."));
+    return scan.set_entries;
   }
 
-  void check_parameter_text(const std::string &text)
+  std::set<std::string> check_parameter_text(const std::string &text)
   {
     std::istringstream in(text);
     TextScan           scan;
     scan_text(in, "input string", {}, scan);
+    return scan.set_entries;
+  }
+
+  void check_given_subsections(const Parameters &p, const std::set<std::string> &set_entries)
+  {
+    // The entries set under a subsection path (prefix ending in '/').
+    const auto entries_under = [&set_entries](const std::string &prefix) {
+      std::vector<std::string> found;
+      for (auto e = set_entries.lower_bound(prefix); e != set_entries.end() && e->compare(0, prefix.size(), prefix) == 0;
+           ++e)
+        found.push_back(e->substr(prefix.size()));
+      return found;
+    };
+    for (std::size_t m = 0; m < p.material_names.size(); ++m)
+      {
+        const std::string section = "Material " + p.material_names[m];
+        // The default material ('soil', linear elastic, when Names is not set) is a documented default.
+        AssertThrow(set_entries.count("Materials/Names") == 0 || !entries_under(section + "/").empty(),
+                    ExcMessage("Parameter 'Materials/Names': the material '" + p.material_names[m] +
+                               "' has no entry in the parameter file: no 'subsection " + section +
+                               "' sets anything, so its Model (linear elastic by default) and all its parameters "
+                               "would be defaults. Give it a 'subsection " + section + "' with 'set Model = ...' "
+                               "and the model's parameters, or remove the name from Materials/Names."));
+        for (const auto &library_entry : material_library())
+          {
+            const std::string &model = library_entry.first;
+            if (model == p.material_models[m])
+              continue;
+            const std::vector<std::string> unread = entries_under(section + "/" + model + "/");
+            if (unread.empty())
+              continue;
+            std::string list;
+            for (const std::string &e : unread)
+              list += (list.empty() ? "" : ", ") + e;
+            AssertThrow(false, ExcMessage("Parameter '" + section + "/Model': it is '" + p.material_models[m] +
+                                          "', but the parameter file sets entries of the model '" + model +
+                                          "' (" + list + " in 'subsection " + model +
+                                          "'), which this material would not read: the run would use '" +
+                                          p.material_models[m] + "' with its own entries. Set Model = " + model +
+                                          ", or remove 'subsection " + model + "' from 'subsection " + section +
+                                          "'."));
+          }
+      }
+    // The same for the default body (one, a 1 m box) where Number of bodies is not set.
+    for (std::size_t b = 1; b <= p.bodies.size(); ++b)
+      AssertThrow(set_entries.count("Material points/Number of bodies") == 0 ||
+                    !entries_under("Material points/Body " + std::to_string(b) + "/").empty(),
+                  ExcMessage("Parameter 'Material points/Number of bodies': it is " +
+                             std::to_string(p.bodies.size()) + ", but the parameter file sets nothing in 'subsection "
+                             "Body " + std::to_string(b) + "' of 'Material points', so that body would be the "
+                             "default one (a 1 m box at the origin). Give every body 1.." +
+                             std::to_string(p.bodies.size()) + " its subsection, or set Number of bodies to the "
+                             "bodies you describe."));
   }
 
   MemoryEstimate estimate_memory(const Parameters &p, double n_points, const unsigned int n_ranks)

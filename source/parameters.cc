@@ -46,6 +46,45 @@ namespace mpm
 
     [[noreturn]] void fail(const std::string &entry, const std::string &what);
 
+    // The first two edges of a closed polygon that meet other than at the vertex they share
+    // (edge k runs from vertex k to vertex k + 1, the last back to vertex 0), or {-1, -1}: the
+    // points fill a polygon by the even-odd rule, so a polygon that crosses itself (vertices in
+    // the wrong order) leaves holes where the two sides overlap.
+    std::pair<int, int> crossing_edges(const std::vector<std::array<double, 2>> &v)
+    {
+      const int  n      = static_cast<int>(v.size());
+      const auto orient = [](const std::array<double, 2> &a, const std::array<double, 2> &b,
+                             const std::array<double, 2> &c) {
+        const double cross = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
+        return (cross > 0) - (cross < 0);
+      };
+      const auto on_segment = [](const std::array<double, 2> &a, const std::array<double, 2> &b,
+                                 const std::array<double, 2> &c) { // c on the line ab: within its box?
+        return std::min(a[0], b[0]) <= c[0] && c[0] <= std::max(a[0], b[0]) && std::min(a[1], b[1]) <= c[1] &&
+               c[1] <= std::max(a[1], b[1]);
+      };
+      for (int k = 0; k < n; ++k)
+        for (int m = k + 1; m < n; ++m)
+          {
+            const auto &a = v[k], &b = v[(k + 1) % n], &c = v[m], &d = v[(m + 1) % n];
+            const int   o1 = orient(a, b, c), o2 = orient(a, b, d), o3 = orient(c, d, a), o4 = orient(c, d, b);
+            const bool  adjacent = m == k + 1 || (k == 0 && m == n - 1);
+            if (adjacent)
+              {
+                // Neighbours share a vertex; they overlap only if they fold back along one line.
+                const auto &shared = m == k + 1 ? b : a, &far_k = m == k + 1 ? a : b, &far_m = m == k + 1 ? d : c;
+                if (orient(far_k, shared, far_m) == 0 &&
+                    (far_m[0] - shared[0]) * (far_k[0] - shared[0]) + (far_m[1] - shared[1]) * (far_k[1] - shared[1]) > 0)
+                  return {k, m};
+                continue;
+              }
+            if ((o1 != o2 && o3 != o4) || (o1 == 0 && on_segment(a, b, c)) || (o2 == 0 && on_segment(a, b, d)) ||
+                (o3 == 0 && on_segment(c, d, a)) || (o4 == 0 && on_segment(c, d, b)))
+              return {k, m};
+          }
+      return {-1, -1};
+    }
+
     // The numbers of a list entry. The pattern has checked their form, but not their range: a
     // value such as 1e-400 matches Patterns::Double and still does not convert.
     std::vector<double> to_doubles(const std::string &entry, const std::string &text)
@@ -788,6 +827,19 @@ namespace mpm
         if (body.shape == "polygon" && body.polygon.size() < 3)
           fail(where + "Polygon vertices", "a polygon needs at least 3 vertices, got " +
                                              std::to_string(body.polygon.size()) + ".");
+        if (body.shape == "polygon")
+          {
+            const auto [k, m] = crossing_edges(body.polygon);
+            const int n = static_cast<int>(body.polygon.size());
+            const auto edge = [n](const int e) {
+              return "from vertex " + std::to_string(e + 1) + " to vertex " + std::to_string((e + 1) % n + 1);
+            };
+            if (k >= 0)
+              fail(where + "Polygon vertices",
+                   "the polygon crosses itself: its edge " + edge(k) + " meets the edge " + edge(m) +
+                     ". Give the vertices in order around the boundary (either direction), so that no two edges "
+                     "cross or overlap.");
+          }
         // The body must lie inside the grid: a point outside could never be used.
         std::vector<double> lo = body.lower, hi = body.upper;
         if (body.shape == "polygon")
@@ -1011,18 +1063,23 @@ namespace mpm
       std::ifstream in(filename);
       AssertThrow(in, ExcMessage("Cannot open the parameter file '" + filename + "'."));
     }
-    check_parameter_file(filename);
-    return read_in_two_passes([&](ParameterHandler &prm, const bool skip_undefined) {
+    const std::optional<std::set<std::string>> set_entries = check_parameter_file(filename);
+    Parameters parameters = read_in_two_passes([&](ParameterHandler &prm, const bool skip_undefined) {
       prm.parse_input(filename, "", skip_undefined, /*assert_mandatory_entries_are_found=*/false);
     });
+    if (set_entries)
+      check_given_subsections(parameters, *set_entries);
+    return parameters;
   }
 
   Parameters parameters_from_string(const std::string &text)
   {
-    check_parameter_text(text);
-    return read_in_two_passes([&](ParameterHandler &prm, const bool skip_undefined) {
+    const std::set<std::string> set_entries = check_parameter_text(text);
+    Parameters parameters = read_in_two_passes([&](ParameterHandler &prm, const bool skip_undefined) {
       prm.parse_input_from_string(text, "", skip_undefined);
     });
+    check_given_subsections(parameters, set_entries);
+    return parameters;
   }
 
   void print_parameters(std::ostream &out, const unsigned int dim, const std::string &style)

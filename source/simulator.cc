@@ -547,8 +547,17 @@ namespace mpm
     if (parameters.output_in_background)
       s.pcout << " (background threads; the run waited " << s.output->waited_seconds() << " s for them)";
     s.pcout << "\n";
-    s.pcout << "  results: " << s.output->directory() << "/particles.pvd, " << s.output->directory()
-            << "/grid.pvd, " << s.output->directory() << "/history.csv" << std::endl;
+    // Only the files this run wrote (Output/Write particles, Write grid fields, Write particle table).
+    const std::string where   = s.output->directory() + "/";
+    const bool        outputs = s.output->n_outputs() > 0;
+    s.pcout << "  results: ";
+    if (outputs && parameters.write_particles)
+      s.pcout << where << "particles.pvd, ";
+    if (outputs && parameters.write_grid_fields)
+      s.pcout << where << "grid.pvd, ";
+    if (outputs && parameters.write_particle_table)
+      s.pcout << where << "particle_table_NNNNN.R.csv (one per output and rank), ";
+    s.pcout << where << "history.csv" << std::endl;
   }
 
   template <int dim>

@@ -18,6 +18,8 @@
 
 #include <mpi.h>
 
+#include <optional>
+#include <set>
 #include <string>
 
 namespace mpm
@@ -32,10 +34,21 @@ namespace mpm
   // (naming the file and line); warns of a line ending in a backslash (deal.II joins the next
   // line to it) where the next line is a statement of its own, and of an entry set twice in
   // one 'subsection ... end' block of one file (the last value wins; a subsection opened again
-  // later, as overrides appended to a scene are, is not warned of).
-  void check_parameter_file(const std::string &filename);
+  // later, as overrides appended to a scene are, is not warned of). Returns the entries the
+  // text sets, as paths "Section/Subsection/Entry" (none for .json or .xml files, which deal.II
+  // reads whole: nullopt).
+  std::optional<std::set<std::string>> check_parameter_file(const std::string &filename);
   // The same checks of prm text given as a string (no refusal of an empty text).
-  void check_parameter_text(const std::string &text);
+  std::set<std::string> check_parameter_text(const std::string &text);
+
+  // Checks of what the text left out, which deal.II fills with defaults without a word: refuses a
+  // material of Materials/Names (where the text sets Names) without any entry in its 'Material
+  // <name>' subsection, a body 1..Number of bodies (where the text sets it) without any entry in
+  // its 'Body <i>' subsection, and entries set in a
+  // built-in model's subsection of a material whose Model is another one (a model changed and
+  // its old parameters left: the new model would run on its defaults). set_entries: what
+  // check_parameter_file returned.
+  void check_given_subsections(const Parameters &parameters, const std::set<std::string> &set_entries);
 
   // Checks of the parsed parameters that no pattern can express, all from the prm alone (so
   // that every rank finds the same): refuses grid and point counts beyond the 32-bit indices
