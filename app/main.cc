@@ -31,7 +31,9 @@ namespace
            "                                       print every parameter with its default and documentation\n"
            "  dealii-mpm --help                    this text\n"
            "SIGTERM or SIGINT (Ctrl-C) during the steps: a checkpoint is written after the current step and\n"
-           "the run stops with exit status 75; a second signal stops it at once.\n";
+           "the run stops with exit status 75; a second signal stops it at once. A pre-failure FEM analysis\n"
+           "has no checkpoints (a signal stops it at once); its MPM stage has, and --resume continues that\n"
+           "stage without the analysis.\n";
   }
 
   // The exit status of a run stopped by SIGTERM/SIGINT after writing its checkpoint
@@ -120,23 +122,26 @@ int main(int argc, char **argv)
           return 2;
         }
       const mpm::Parameters parameters = mpm::read_parameters(prm);
+      const auto            catch_signals = [] {
+        std::signal(SIGTERM, stop_after_checkpoint);
+        std::signal(SIGINT, stop_after_checkpoint);
+      };
+      // A pre-failure analysis has no checkpoints: a signal stops it at once, and only its MPM
+      // stage catches signals (and is resumed without the analysis).
+      bool ran_to_end = true;
       if (parameters.prefailure.analysis != mpm::fem::Analysis::none)
-        {
-          AssertThrow(resume.empty(), dealii::ExcMessage("--resume: a pre-failure analysis (Pre-failure analysis/"
-                                                         "Method) has no checkpoints; resume the MPM run instead."));
-          mpm::fem::run_prefailure_analysis(parameters, MPI_COMM_WORLD);
-        }
+        ran_to_end = mpm::fem::run_prefailure_analysis(parameters, MPI_COMM_WORLD, resume, catch_signals);
       else
         {
-          std::signal(SIGTERM, stop_after_checkpoint);
-          std::signal(SIGINT, stop_after_checkpoint);
-          if (!mpm::run_simulation(parameters, MPI_COMM_WORLD, resume))
-            {
-              if (root)
-                std::cout << "  continue with: dealii-mpm " << prm << " --resume "
-                          << parameters.checkpoint_directory << std::endl;
-              return exit_stopped;
-            }
+          catch_signals();
+          ran_to_end = mpm::run_simulation(parameters, MPI_COMM_WORLD, resume);
+        }
+      if (!ran_to_end)
+        {
+          if (root)
+            std::cout << "  continue with: dealii-mpm " << prm << " --resume " << parameters.checkpoint_directory
+                      << std::endl;
+          return exit_stopped;
         }
     }
   catch (const dealii::ExceptionBase &e)

@@ -27,7 +27,7 @@ namespace mpm
   template <class Archive>
   void RunState::serialize(Archive &archive, const unsigned int /*version*/)
   {
-    archive &dim &n_ranks &lower &upper &cell_size &n_materials &state_variable_names;
+    archive &dim &n_ranks &lower &upper &cell_size &n_materials &state_variable_names &strength_divisor;
     archive &time &dt &max_speed &max_removed_speed &work_of_gravity &elastic_wave_speed &smallest_point_mass
       &balanced &next_output;
     archive &step &n_points_initial &n_removed &n_resorts &n_repartitions &n_sent &plastic;
@@ -42,7 +42,19 @@ namespace mpm
     namespace
     {
       // Marks the files of this format; a file of another kind or version is refused.
-      constexpr unsigned int format = 0x4d504d01; // "MPM" 1
+      // Format 2 (2026-12-03): the run's strength divisor (a pre-failure hand-over's).
+      constexpr unsigned int format = 0x4d504d02, format_1 = 0x4d504d01; // "MPM" 2, "MPM" 1
+
+      // Refuses a file of another format, naming it.
+      void check_format(const unsigned int magic, const std::string &file)
+      {
+        AssertThrow(magic != format_1,
+                    dealii::ExcMessage("--resume: '" + file + "' was written by an earlier dealii-mpm (checkpoint "
+                                       "format 1, before 2026-12-03), which this one does not read: resume it "
+                                       "with the version that wrote it."));
+        AssertThrow(magic == format,
+                    dealii::ExcMessage("--resume: '" + file + "' is not a dealii-mpm checkpoint file."));
+      }
 
       const std::string partial_suffix = ".partial";
 
@@ -135,7 +147,7 @@ namespace mpm
         unsigned int                    magic = 0, dimension = 0;
         int                             n = 0, n_state_variables = 0;
         archive >> magic;
-        AssertThrow(magic == format, dealii::ExcMessage("--resume: '" + file + "' is not a dealii-mpm checkpoint file."));
+        check_format(magic, file);
         archive >> dimension >> n >> n_state_variables;
         std::vector<std::string> names;
         archive >> names;
@@ -260,20 +272,21 @@ namespace mpm
       const std::string file = checkpoint + "/run.state";
       std::ifstream     in(file, std::ios::binary);
       AssertThrow(in, dealii::ExcMessage("--resume: cannot read '" + file + "'."));
-      RunState state;
+      RunState     state;
+      unsigned int magic = 0;
       try
         {
           boost::archive::binary_iarchive archive(in);
-          unsigned int                    magic = 0;
           archive >> magic;
-          AssertThrow(magic == format, dealii::ExcMessage("not a dealii-mpm checkpoint"));
-          archive >> state;
+          if (magic == format)
+            archive >> state;
         }
       catch (const std::exception &e)
         {
           AssertThrow(false, dealii::ExcMessage("--resume: '" + file + "' cannot be read as a dealii-mpm "
                                                 "checkpoint (" + e.what() + ")."));
         }
+      check_format(magic, file);
       return state;
     }
 

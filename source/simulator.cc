@@ -457,8 +457,9 @@ namespace mpm
     if (s.step % parameters.history_every != 0)
       s.record_history();
     const double end = parameters.end_time;
-    if (!(parameters.output_interval > 0 &&
-          std::abs(s.time - (s.next_output - parameters.output_interval)) < 1e-12 * end))
+    // Not again where the last output was at this time (End time = 0 included: one output at t = 0).
+    if (!(parameters.output_interval > 0 && std::abs(s.time - (s.next_output - parameters.output_interval)) <=
+                                              1e-12 * std::max(end, parameters.output_interval)))
       s.write_output();
     // The handler is not brought up to date at the end: nothing reads it after the run
     // (the last output and the totals come from the engine). That hand-over cost 2.2 s of

@@ -33,6 +33,11 @@ namespace mpm
                                      " material(s); Materials/Names declares " + std::to_string(p.materials.size()) +
                                      " (the materials, their order and their models must be those of the run that "
                                      "wrote it)."));
+      AssertThrow(r.strength_divisor == p.strength_divisor,
+                  dealii::ExcMessage(of + "was written with the materials' strengths divided by " +
+                                     std::to_string(r.strength_divisor) + " (a pre-failure analysis's hand-over); "
+                                     "this run divides them by " + std::to_string(p.strength_divisor) +
+                                     ". Resume it with the parameter file of the run that wrote it."));
     }
   } // namespace
 

@@ -583,6 +583,7 @@ namespace mpm
       r.cell_size            = parameters.cell_size;
       r.n_materials          = parameters.materials.size();
       r.state_variable_names = parameters.state_variable_names();
+      r.strength_divisor     = parameters.strength_divisor;
       r.time                 = time;
       r.dt                   = dt;
       r.max_speed            = max_speed;

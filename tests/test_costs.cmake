@@ -24,6 +24,7 @@ else()
     prm/fuzz_mutations 58
     prm/mpi/fuzz_mutations_np2 48
     examples/elastic_slope_handoff 48
+    prm/checkpoint/TERM_prefailure_resume 34
     core/test_domain_update 33
     stability/flip_noise/linear 33
     fem/test_prefailure_np4 30

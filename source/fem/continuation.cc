@@ -1,6 +1,7 @@
 // The executable's path through a pre-failure analysis: the analysis, then the MPM from its
 // state through the hand-over API, exactly as a user's own FEM program would hand it over.
 #include <mpm/core/material/strength_reduction.h>
+#include <mpm/dealii/checkpoint.h>
 #include <mpm/dealii/fem_handover.h>
 #include <mpm/dealii/simulator.h>
 #include <mpm/fem/continuation.h>
@@ -17,15 +18,56 @@ namespace mpm::fem
 
   namespace
   {
+    // The MPM's parameters: the prm's, with the materials' strengths divided by factor.
+    Parameters with_strength_divided(const Parameters &parameters, const double factor)
+    {
+      Parameters mpm = parameters;
+      for (MaterialParameters<double> &m : mpm.materials)
+        m = with_reduced_strength(m, factor);
+      mpm.strength_divisor = factor;
+      return mpm;
+    }
+
+    // The MPM stage continued from its checkpoint: the analysis is not run again.
     template <int dim>
-    void run(const Parameters &parameters, const MPI_Comm communicator)
+    bool resume(const Parameters &parameters, const MPI_Comm communicator, const std::string &resume_from,
+                const std::function<void()> &before_mpm)
+    {
+      AssertThrow(parameters.prefailure.continue_with_mpm,
+                  ExcMessage("--resume: Pre-failure analysis/Continue with MPM is false, so this scene has no MPM "
+                             "stage and no checkpoints to resume."));
+      const RunState checkpoint_state = checkpoint::read_state(checkpoint::find(resume_from));
+      // 'failing factor' is the analysis's result, known only from the checkpoint; a number must match it.
+      const PrefailureParameters &p = parameters.prefailure;
+      AssertThrow(p.mpm_strength_from_failure || p.mpm_strength_factor == checkpoint_state.strength_divisor,
+                  ExcMessage("Parameter 'Pre-failure analysis/MPM strength factor': it is " +
+                             std::to_string(p.mpm_strength_factor) + ", but the checkpoint given to --resume was "
+                             "written by an MPM stage whose strengths were divided by " +
+                             std::to_string(checkpoint_state.strength_divisor) +
+                             ". Resume with the parameter file of the run that wrote it."));
+      ConditionalOStream pcout(std::cout, Utilities::MPI::this_mpi_process(communicator) == 0);
+      pcout << "Pre-failure analysis: not run again; the MPM resumes with the strengths of the checkpoint's run "
+               "(the prm's divided by "
+            << checkpoint_state.strength_divisor << ")" << std::endl;
+      Simulator<dim> simulator(with_strength_divided(parameters, checkpoint_state.strength_divisor), communicator);
+      simulator.resume(resume_from);
+      if (before_mpm)
+        before_mpm();
+      while (!simulator.finished())
+        simulator.advance();
+      simulator.finish();
+      return !simulator.stopped();
+    }
+
+    template <int dim>
+    bool run(const Parameters &parameters, const MPI_Comm communicator, const std::function<void()> &before_mpm)
     {
       ConditionalOStream          pcout(std::cout, Utilities::MPI::this_mpi_process(communicator) == 0);
       PrefailureAnalysis<dim>     analysis(parameters, communicator);
       const PrefailureResult      result = analysis.run();
       const PrefailureParameters &p      = parameters.prefailure;
       if (!p.continue_with_mpm)
-        return;
+        return true;
 
       double factor = p.mpm_strength_factor;
       if (p.mpm_strength_from_failure)
@@ -36,9 +78,7 @@ namespace mpm::fem
                                  "number."));
           factor = result.failing_factor;
         }
-      Parameters mpm = parameters;
-      for (MaterialParameters<double> &m : mpm.materials)
-        m = with_reduced_strength(m, factor);
+      const Parameters mpm = with_strength_divided(parameters, factor);
 
       std::map<types::material_id, HandoverMaterial> handover;
       for (const auto &[id, m] : analysis.materials())
@@ -55,17 +95,22 @@ namespace mpm::fem
             << "; the MPM's strengths are the prm's divided by " << factor << std::endl;
       Simulator<dim> simulator(mpm, communicator);
       simulator.setup({std::move(body)});
+      if (before_mpm)
+        before_mpm();
       while (!simulator.finished())
         simulator.advance();
       simulator.finish();
+      return !simulator.stopped();
     }
   } // namespace
 
-  void run_prefailure_analysis(const Parameters &parameters, const MPI_Comm communicator)
+  bool run_prefailure_analysis(const Parameters &parameters, const MPI_Comm communicator,
+                               const std::string &resume_from, const std::function<void()> &before_mpm)
   {
-    if (parameters.dim == 2)
-      run<2>(parameters, communicator);
-    else
-      run<3>(parameters, communicator);
+    if (!resume_from.empty())
+      return parameters.dim == 2 ? resume<2>(parameters, communicator, resume_from, before_mpm) :
+                                   resume<3>(parameters, communicator, resume_from, before_mpm);
+    return parameters.dim == 2 ? run<2>(parameters, communicator, before_mpm) :
+                                 run<3>(parameters, communicator, before_mpm);
   }
 } // namespace mpm::fem

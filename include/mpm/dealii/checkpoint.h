@@ -31,6 +31,7 @@ namespace mpm
     double                   cell_size = 0;
     unsigned int             n_materials = 0;
     std::vector<std::string> state_variable_names;
+    double                   strength_divisor = 1; // Parameters::strength_divisor
 
     // The simulated clock and what the next step's time step and checks depend on.
     double time = 0, dt = 0, max_speed = 0, max_removed_speed = 0, work_of_gravity = 0, elastic_wave_speed = 0,

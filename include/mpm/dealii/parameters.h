@@ -120,6 +120,11 @@ namespace mpm
     double load_balance_threshold; // repartition when max/mean work per rank exceeds it; 0 = never
     double point_weight;           // work of one point relative to one empty cell
 
+    // Not a prm entry: the materials' strengths are the prm's divided by this (a pre-failure
+    // analysis's hand-over sets it, fem/continuation.cc). Checkpoints record it, and a resumed
+    // run must have the same (--resume of such a scene skips the FEM and sets it from there).
+    double strength_divisor = 1;
+
     // Initial state: "prm bodies" (Material points) or "FEM file" (fem_state_file.h)
     std::string  initial_state_source = "prm bodies";
     std::string  fem_file;

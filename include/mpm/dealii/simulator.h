@@ -72,10 +72,10 @@ namespace mpm
 
     // Instead of setup(): continues the run from a checkpoint (doc/checkpoints.md): the
     // folder of one (checkpoint-NNNNNNNNN) or the folder holding them (the newest complete one
-    // is taken), written by a run of the same scene on any number of ranks. The grid and the
-    // materials' names must be the prm's; End time, output, checkpoint and solver settings
-    // may differ and apply from the resumed step on. On as many ranks as wrote it (CPU), the
-    // resumed run ends bit-identical to the run that was not stopped.
+    // is taken), written by a run of the same scene on any number of ranks. The grid, the
+    // materials' names and Parameters::strength_divisor must be the prm's; End time, output,
+    // checkpoint and solver settings may differ and apply from the resumed step on. On as many
+    // ranks as wrote it (CPU), the resumed run ends bit-identical to the run that was not stopped.
     void resume(const std::string &checkpoint);
     // Writes a checkpoint of the run as it is after the last step, collectively, into
     // Checkpoint/Directory, and returns its folder. advance() writes them where Checkpoint

@@ -7,7 +7,17 @@
 
 #include <mpi.h>
 
+#include <functional>
+#include <string>
+
 namespace mpm::fem
 {
-  void run_prefailure_analysis(const Parameters &parameters, MPI_Comm communicator);
+  // before_mpm is called once the MPM's steps are about to start (the executable installs its
+  // SIGTERM/SIGINT handlers there: the FEM stage has no checkpoints, and a signal stops it at
+  // once). resume_from: a checkpoint of the MPM stage (Simulator::resume); the analysis is then
+  // not run again, and the materials' strengths are divided as in the run that wrote it.
+  // Returns false where the MPM was stopped on request (request_checkpoint_and_stop) after
+  // writing its checkpoint, true otherwise.
+  bool run_prefailure_analysis(const Parameters &parameters, MPI_Comm communicator,
+                               const std::string &resume_from = "", const std::function<void()> &before_mpm = {});
 } // namespace mpm::fem
