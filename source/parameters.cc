@@ -8,9 +8,12 @@
 #include <deal.II/base/utilities.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <fstream>
 #include <limits>
+#include <iomanip>
+#include <set>
 #include <sstream>
 
 namespace mpm
@@ -639,9 +642,15 @@ namespace mpm
           }
         catch (const dealii::ExceptionBase &e)
           {
+            // A model's checks say "Entry 'NAME' what": named here by the entry's whole path.
             std::ostringstream info;
             e.print_info(info);
-            fail("Material " + name + "/" + model, info.str());
+            const std::string what    = dealii::Utilities::trim(info.str());
+            const std::string section = "Material " + name + "/" + model;
+            const std::size_t closing = what.find("' ", 7);
+            if (what.rfind("Entry '", 0) == 0 && closing != std::string::npos)
+              fail(section + "/" + what.substr(7, closing - 7), what.substr(closing + 2));
+            fail(section, what);
           }
         prm.leave_subsection();
         if (prm.get("Elastic law") == "Hencky")
@@ -854,18 +863,27 @@ namespace mpm
                 hi[dim - 1] = std::max(hi[dim - 1], v[1]);
               }
           }
-        const std::string extent = body.shape == "polygon" ? "Polygon vertices" : "Lower corner";
+        // The entry at fault: a polygon's vertices, or the box corner on the side that is wrong.
+        const auto entry = [&body](const bool upper_side) {
+          return body.shape == "polygon" ? std::string("Polygon vertices") :
+                                           std::string(upper_side ? "Upper corner" : "Lower corner");
+        };
+        const auto number = [](const double x) { // 0.6, not 0.59999999999999998
+          std::ostringstream out;
+          out << std::setprecision(12) << x;
+          return out.str();
+        };
         for (unsigned int d = 0; d < dim; ++d)
           {
             if (!(hi[d] > lo[d]))
-              fail(where + (body.shape == "polygon" ? extent : std::string("Upper corner")),
-                   std::string("the body has no extent in ") + axis_names[d] + ".");
+              fail(where + entry(true), std::string(hi[d] < lo[d] ? "the upper corner lies below the lower one in " :
+                                                                      "the body has no extent in ") +
+                                          axis_names[d] + " (" + number(lo[d]) + " to " + number(hi[d]) + ").");
             if (lo[d] < lower[d] - 1e-12 || hi[d] > upper[d] + 1e-12)
-              fail(where + extent, std::string("the body reaches outside the grid in ") + axis_names[d] + " ([" +
-                                     dealii::Utilities::to_string(lo[d]) + ", " +
-                                     dealii::Utilities::to_string(hi[d]) + "] is not inside [" +
-                                     dealii::Utilities::to_string(lower[d]) + ", " +
-                                     dealii::Utilities::to_string(upper[d]) + "]).");
+              fail(where + entry(hi[d] > upper[d] + 1e-12),
+                   std::string("the body reaches outside the grid in ") + axis_names[d] + " ([" + number(lo[d]) +
+                     ", " + number(hi[d]) + "] is not inside [" + number(lower[d]) + ", " + number(upper[d]) +
+                     "]).");
           }
         if (body.shape == "cylinder")
           for (unsigned int d = 0; d < 2; ++d)
@@ -1031,6 +1049,73 @@ namespace mpm
 
   namespace
   {
+    // Edit distance of two names, case-insensitive (a typo's distance to what was meant).
+    std::size_t edit_distance(const std::string &a, const std::string &b)
+    {
+      std::vector<std::size_t> row(b.size() + 1);
+      for (std::size_t j = 0; j <= b.size(); ++j)
+        row[j] = j;
+      for (std::size_t i = 1; i <= a.size(); ++i)
+        {
+          std::size_t diagonal = row[0];
+          row[0]               = i;
+          for (std::size_t j = 1; j <= b.size(); ++j)
+            {
+              const std::size_t above = row[j];
+              const bool same = std::tolower(static_cast<unsigned char>(a[i - 1])) ==
+                                std::tolower(static_cast<unsigned char>(b[j - 1]));
+              row[j]   = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (same ? 0 : 1)});
+              diagonal = above;
+            }
+        }
+      return row[b.size()];
+    }
+
+    // For deal.II's messages of an undeclared entry or subsection ("No entry with name <X>",
+    // "no such subsection to be entered: X"): the declared entries (as 'Section/Entry') or
+    // subsections whose name is closest to X, within a third of its length; empty otherwise.
+    std::string closest_declared_name(const ParameterHandler &prm, const std::string &message)
+    {
+      std::string unknown;
+      bool        subsection = false;
+      if (const std::size_t at = message.find("No entry with name <"); at != std::string::npos)
+        unknown = message.substr(at + 20, message.find('>', at + 20) - (at + 20));
+      else if (const std::size_t at = message.find("no such subsection to be entered: "); at != std::string::npos)
+        {
+          unknown    = dealii::Utilities::trim(message.substr(at + 34));
+          subsection = true;
+        }
+      if (unknown.empty())
+        return "";
+      std::ostringstream listing;
+      prm.print_parameters(listing, ParameterHandler::ShortPRM);
+      std::set<std::string> candidates;
+      for (const std::string &path : check_parameter_text(listing.str()))
+        {
+          std::vector<std::string> parts = dealii::Utilities::split_string_list(path, '/');
+          if (!subsection)
+            candidates.insert(path);
+          else
+            for (std::size_t k = 0; k + 1 < parts.size(); ++k)
+              candidates.insert(parts[k]);
+        }
+      std::size_t best = unknown.size() / 3 + 1;
+      std::string found;
+      for (const std::string &candidate : candidates)
+        {
+          const std::string name     = subsection ? candidate : candidate.substr(candidate.rfind('/') + 1);
+          const std::size_t distance = edit_distance(unknown, name);
+          if (distance < best)
+            {
+              best  = distance;
+              found = "'" + candidate + "'";
+            }
+          else if (distance == best && !found.empty() && found.size() < 400)
+            found += " or '" + candidate + "'";
+        }
+      return found;
+    }
+
     // The two passes of a read: the first finds the dimension, the number of bodies and the
     // material names (everything else skipped), the second declares every entry for them and
     // rejects unknown ones. parse(prm, skip_undefined) reads the input into prm.
@@ -1050,7 +1135,24 @@ namespace mpm
 
       ParameterHandler prm;
       Parameters::declare(prm, dim, n_bodies, names);
-      parse(prm, false);
+      try
+        {
+          parse(prm, false);
+        }
+      catch (const dealii::ExceptionBase &e)
+        {
+          std::ostringstream info;
+          e.print_info(info);
+          const std::string suggestion = closest_declared_name(prm, info.str());
+          if (suggestion.empty())
+            throw;
+          std::string message = dealii::Utilities::trim(info.str());
+          if (!message.empty() && message.back() != '.')
+            message += '.';
+          AssertThrow(false, ExcMessage(message + " Did you mean " + suggestion +
+                                        "? (dealii-mpm --print-parameters " + std::to_string(dim) +
+                                        " lists every entry.)"));
+        }
       Parameters parameters;
       parameters.parse(prm);
       return parameters;
