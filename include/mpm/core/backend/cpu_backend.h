@@ -206,8 +206,10 @@ namespace mpm
     T reduce_points(const int n, const T identity, F &&f, Combine &&combine) const
     {
 #ifdef MPM_WITH_TBB
+      // Deterministic: the same chunks combined in the same tree on any run and thread count, so
+      // that sums (the history's mass, energy, momentum) repeat to the last bit.
       if (n > grain)
-        return tbb::parallel_reduce(
+        return tbb::parallel_deterministic_reduce(
           tbb::blocked_range<int>(0, n, grain), identity,
           [&](const tbb::blocked_range<int> &r, T acc) {
             for (int i = r.begin(); i < r.end(); ++i)
