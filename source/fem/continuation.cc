@@ -28,6 +28,19 @@ namespace mpm::fem
       return mpm;
     }
 
+    // The MPM's steps to End time from a simulator set up or resumed; false where it was stopped
+    // on request (after its checkpoint).
+    template <int dim>
+    bool step_to_end(Simulator<dim> &simulator, const std::function<void()> &before_mpm)
+    {
+      if (before_mpm)
+        before_mpm();
+      while (!simulator.finished())
+        simulator.advance();
+      simulator.finish();
+      return !simulator.stopped();
+    }
+
     // The MPM stage continued from its checkpoint: the analysis is not run again.
     template <int dim>
     bool resume(const Parameters &parameters, const MPI_Comm communicator, const std::string &resume_from,
@@ -51,12 +64,7 @@ namespace mpm::fem
             << checkpoint_state.strength_divisor << ")" << std::endl;
       Simulator<dim> simulator(with_strength_divided(parameters, checkpoint_state.strength_divisor), communicator);
       simulator.resume(resume_from);
-      if (before_mpm)
-        before_mpm();
-      while (!simulator.finished())
-        simulator.advance();
-      simulator.finish();
-      return !simulator.stopped();
+      return step_to_end(simulator, before_mpm);
     }
 
     template <int dim>
@@ -95,12 +103,7 @@ namespace mpm::fem
             << "; the MPM's strengths are the prm's divided by " << factor << std::endl;
       Simulator<dim> simulator(mpm, communicator);
       simulator.setup({std::move(body)});
-      if (before_mpm)
-        before_mpm();
-      while (!simulator.finished())
-        simulator.advance();
-      simulator.finish();
-      return !simulator.stopped();
+      return step_to_end(simulator, before_mpm);
     }
   } // namespace
 

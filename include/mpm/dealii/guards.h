@@ -41,13 +41,13 @@ namespace mpm
   // The same checks of prm text given as a string (no refusal of an empty text).
   std::set<std::string> check_parameter_text(const std::string &text);
 
-  // Checks of what the text left out, which deal.II fills with defaults without a word: refuses a
-  // material of Materials/Names (where the text sets Names) without any entry in its 'Material
-  // <name>' subsection, a body 1..Number of bodies (where the text sets it) without any entry in
-  // its 'Body <i>' subsection, and entries set in a
-  // built-in model's subsection of a material whose Model is another one (a model changed and
-  // its old parameters left: the new model would run on its defaults). set_entries: what
-  // check_parameter_file returned.
+  // Checks of what the text left out, which deal.II fills with defaults without a word. Refuses
+  // (throws, naming the entry): a material of Materials/Names (where the text sets Names) without
+  // any entry in its 'Material <name>' subsection; a body 1..Number of bodies (where the text sets
+  // it) without any entry in its 'Body <i>' subsection; entries set in a registered model's
+  // subsection of a material whose Model is another one (a model changed and its old parameters
+  // left: the new model would run on its defaults). parameters: as parsed from that text;
+  // set_entries: what check_parameter_file or check_parameter_text returned for it.
   void check_given_subsections(const Parameters &parameters, const std::set<std::string> &set_entries);
 
   // Checks of the parsed parameters that no pattern can express, all from the prm alone (so
