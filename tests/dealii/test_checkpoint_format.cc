@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <sstream>
 #include <string>
 
 namespace
@@ -32,7 +33,14 @@ namespace
       }
     catch (const dealii::ExceptionBase &e)
       {
-        return e.what();
+        // The message alone, its words joined by single spaces (deal.II's what() wraps lines).
+        std::ostringstream info;
+        e.print_info(info);
+        std::istringstream words(info.str());
+        std::string        joined, word;
+        while (words >> word)
+          joined += (joined.empty() ? "" : " ") + word;
+        return joined;
       }
     return "";
   }
