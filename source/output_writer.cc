@@ -11,6 +11,7 @@
 #include <functional>
 #include <iomanip>
 #include <memory>
+#include <regex>
 #include <sstream>
 
 namespace mpm
@@ -556,6 +557,38 @@ namespace mpm
             << r.n_repartitions << ',' << r.n_sent << ',' << r.removed_mass << ',' << r.mass_balance;
     history << '\n';
     history.flush();
+  }
+
+  template <int dim>
+  std::vector<std::string> OutputWriter<dim>::files_of_earlier_runs() const
+  {
+    std::vector<std::string> found;
+    if (rank != 0)
+      return found;
+    // Our names: KIND.pvd, KIND_NNNNN.pvtu, KIND_NNNNN.P.vtu, particle_table_NNNNN.R.csv.
+    static const std::regex numbered(R"(^(particles|grid|particle_table)_([0-9]{5})\.(pvtu|[0-9]+\.vtu|[0-9]+\.csv)$)");
+    static const std::regex record(R"(^(particles|grid)\.pvd$)");
+    const auto written = [&](const std::string &kind) {
+      return kind == "particles" ? write_particles : kind == "grid" ? write_grid : write_table;
+    };
+    std::error_code error;
+    for (const auto &entry : std::filesystem::directory_iterator(output_directory, error))
+      {
+        const std::string name = entry.path().filename().string();
+        std::smatch       match;
+        if (std::regex_match(name, match, numbered))
+          {
+            const bool table_file = match[3].str().size() > 4 && match[3].str().substr(match[3].str().size() - 4) == ".csv";
+            if ((match[1] == "particle_table") != table_file)
+              continue; // not a name this writer makes (e.g. particles_00001.0.csv)
+            if (!written(match[1]) || std::stoul(match[2]) >= counter)
+              found.push_back(name);
+          }
+        else if (std::regex_match(name, match, record) && (!written(match[1]) || counter == 0))
+          found.push_back(name);
+      }
+    std::sort(found.begin(), found.end());
+    return found;
   }
 
   template struct GridSnapshot<2>;

@@ -380,7 +380,8 @@ namespace mpm
 
     prm.enter_subsection("Output");
     prm.declare_entry("Directory", "output", Patterns::DirectoryName(),
-                      "Folder for .vtu/.pvtu/.pvd files and the time history; created if missing.");
+                      "Folder for .vtu/.pvtu/.pvd files and the time history; created if missing. Files of an earlier "
+                      "run there that this run does not overwrite are kept, and the run warns of them at its end.");
     prm.declare_entry("Output interval", "0.1", Patterns::Double(0),
                       "Simulated time between field outputs (s); 0 = only the initial and final states.");
     prm.declare_entry("Write grid fields", "true", Patterns::Bool(),

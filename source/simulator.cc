@@ -559,6 +559,16 @@ namespace mpm
     if (outputs && parameters.write_particle_table)
       s.pcout << where << "particle_table_NNNNN.R.csv (one per output and rank), ";
     s.pcout << where << "history.csv" << std::endl;
+    // Files an earlier run left here would be found by a glob or a file dialog beside this
+    // run's: said once, not removed (they are the user's).
+    const auto earlier = s.output->files_of_earlier_runs();
+    if (!earlier.empty())
+      warn_about_parameter("Output/Directory",
+                           "'" + s.output->directory() + "' also holds " + std::to_string(earlier.size()) +
+                             " file(s) that this run did not write, left by an earlier run (" + earlier.front() +
+                             (earlier.size() > 1 ? " ... " + earlier.back() : std::string()) +
+                             "); they are in none of this run's .pvd records. Remove them, or give each run its "
+                             "own directory.");
   }
 
   template <int dim>

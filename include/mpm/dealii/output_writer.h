@@ -172,6 +172,13 @@ namespace mpm
     double       task_seconds() const { return 1e-9 * task_nanoseconds; }
     double       waited_seconds() const { return waited; }
 
+    // Files in the output directory in this writer's naming that this run did not write:
+    // outputs numbered from n_outputs() on, and kinds of file this run does not write
+    // (an earlier, longer run's, or one with other Output/Write settings). They are in no
+    // .pvd record of this run, but a script or a file dialog would still find them.
+    // Sorted; empty on ranks other than 0.
+    std::vector<std::string> files_of_earlier_runs() const;
+
   private:
     // Writes the files of time t from the grid's snapshot (null: no grid files) and the
     // points' (next_snapshot), on background threads where asked.
