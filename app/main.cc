@@ -1,9 +1,11 @@
 // dealii-mpm: explicit material point method for large deformation of soils.
 //   dealii-mpm scene.prm              run a scene
 //   dealii-mpm scene.prm --resume DIR continue it from a checkpoint
+//   dealii-mpm scene.prm --check      check it without running it (run_forecast.h)
 //   dealii-mpm --print-parameters [2|3] [prm|description|json]
 //   dealii-mpm --help
 #include <mpm/dealii/parameters.h>
+#include <mpm/dealii/run_forecast.h>
 #include <mpm/dealii/simulator.h>
 #include <mpm/fem/continuation.h>
 
@@ -27,6 +29,9 @@ namespace
            "                                       (checkpoint-NNNNNNNNN) or the folder holding them\n"
            "                                       (Checkpoint/Directory; the newest is taken), on any\n"
            "                                       number of ranks\n"
+           "  dealii-mpm scene.prm --check         check the scene without running it: the grid, the\n"
+           "                                       points, the first time step and the steps it predicts,\n"
+           "                                       the outputs and the memory it would take\n"
            "  dealii-mpm --print-parameters [2|3] [prm|description|json]\n"
            "                                       print every parameter with its default and documentation\n"
            "  dealii-mpm --help                    this text\n"
@@ -99,20 +104,23 @@ int main(int argc, char **argv)
             mpm::print_parameters(std::cout, std::stoi(dim), style);
           return 0;
         }
-      // scene.prm, or scene.prm --resume DIR (either order).
+      // scene.prm, scene.prm --resume DIR (either order), or scene.prm --check.
       std::string prm, resume;
-      bool        well_formed = argc == 2 || argc == 4;
+      bool        check       = false;
+      bool        well_formed = argc == 2 || argc == 3 || argc == 4;
       for (int a = 1; a < argc && well_formed; ++a)
         {
           const std::string arg = argv[a];
           if (arg == "--resume" && a + 1 < argc && resume.empty())
             resume = argv[++a];
+          else if (arg == "--check" && !check)
+            check = true;
           else if (!arg.empty() && arg[0] != '-' && prm.empty())
             prm = arg;
           else
             well_formed = false;
         }
-      if (!well_formed || prm.empty() || (argc == 4 && resume.empty()))
+      if (!well_formed || prm.empty() || (argc == 4 && resume.empty()) || (argc == 3 && !check))
         {
           if (root)
             {
@@ -122,6 +130,11 @@ int main(int argc, char **argv)
           return 2;
         }
       const mpm::Parameters parameters = mpm::read_parameters(prm);
+      if (check)
+        {
+          mpm::print_run_forecast(std::cout, parameters, MPI_COMM_WORLD);
+          return 0;
+        }
       const auto            catch_signals = [] {
         std::signal(SIGTERM, stop_after_checkpoint);
         std::signal(SIGINT, stop_after_checkpoint);

@@ -394,6 +394,57 @@ namespace mpm
     return e;
   }
 
+  FirstStep first_time_step(const Parameters &p)
+  {
+    // The elastic wave speed of the stiffest body sets the first step (the adaptive step
+    // shrinks further as the points speed up).
+    FirstStep f;
+    auto      wave_speed = [&](const unsigned int material, const double density, const std::string &where) {
+      const double c = std::sqrt(p.materials[material].elastic.p_wave_modulus() / density);
+      if (!(c <= f.c_el)) // the largest, or the first that is not a number
+        {
+          f.c_el   = c;
+          f.set_by = "Material " + p.material_names[material] + "/" + p.material_models[material] +
+                     "/Young's modulus (" + number(p.materials[material].elastic.youngs_modulus) +
+                     " Pa) and Poisson's ratio (" + number(p.materials[material].elastic.poissons_ratio) + ") with " +
+                     where + " (" + number(density) + " kg/m^3)";
+        }
+    };
+    for (unsigned int b = 0; b < p.bodies.size(); ++b)
+      {
+        wave_speed(p.body_material[b], p.bodies[b].density, "Material points/Body " + std::to_string(b + 1) + "/Density");
+        double v2 = 0;
+        for (const double v : p.bodies[b].velocity)
+          v2 += v * v;
+        f.v0 = std::max(f.v0, std::sqrt(v2));
+      }
+    for (const auto &[id, material_and_density] : p.fem_materials)
+      wave_speed(material_and_density.first, material_and_density.second,
+                 "the density of Initial state/Materials' id " + std::to_string(id));
+    if (f.set_by.empty())
+      return f;
+    f.dt    = p.adaptive_time_step ? p.cfl * p.cell_size / (f.c_el + f.v0) : p.fixed_time_step;
+    f.steps = p.end_time / f.dt;
+    // An output interval below the step cuts every step to land on an output time (at
+    // least 1e-12 End time, source/simulator.cc): the outputs then set the steps.
+    f.landing = p.output_interval > 0 && p.output_interval < f.dt;
+    if (f.landing)
+      f.steps = p.end_time / std::max(p.output_interval, 1e-12 * p.end_time);
+    if (p.max_steps > 0)
+      f.steps = std::min(f.steps, double(p.max_steps));
+    return f;
+  }
+
+  double predicted_outputs(const Parameters &p)
+  {
+    if (!(p.output_interval > 0))
+      return p.end_time > 0 ? 2 : 1; // the initial and the final state
+    double outputs = std::floor(p.end_time / p.output_interval * (1 + 1e-12)) + 1;
+    if (p.max_steps > 0)
+      outputs = std::min(outputs, p.max_steps + 1.0); // at most one a step
+    return outputs;
+  }
+
   void check_run_size(const Parameters &p)
   {
     const unsigned int dim = p.dim;
@@ -429,43 +480,13 @@ namespace mpm
                  "number. Check Grid/Cell size and Points per cell direction.");
       }
 
-    // The first time step, and how many steps it predicts to End time: the elastic wave speed
-    // of the stiffest body sets it (the adaptive step shrinks further as the points speed up).
-    double      c_el = 0, v0 = 0;
-    std::string set_by;
-    auto        wave_speed = [&](const unsigned int material, const double density, const std::string &where) {
-      const double c = std::sqrt(p.materials[material].elastic.p_wave_modulus() / density);
-      if (!(c <= c_el)) // the largest, or the first that is not a number
-        {
-          c_el   = c;
-          set_by = "Material " + p.material_names[material] + "/" + p.material_models[material] +
-                   "/Young's modulus (" + number(p.materials[material].elastic.youngs_modulus) +
-                   " Pa) and Poisson's ratio (" + number(p.materials[material].elastic.poissons_ratio) + ") with " +
-                   where + " (" + number(density) + " kg/m^3)";
-        }
-    };
-    for (unsigned int b = 0; b < p.bodies.size(); ++b)
-      {
-        wave_speed(p.body_material[b], p.bodies[b].density, "Material points/Body " + std::to_string(b + 1) + "/Density");
-        double v2 = 0;
-        for (const double v : p.bodies[b].velocity)
-          v2 += v * v;
-        v0 = std::max(v0, std::sqrt(v2));
-      }
-    for (const auto &[id, material_and_density] : p.fem_materials)
-      wave_speed(material_and_density.first, material_and_density.second,
-                 "the density of Initial state/Materials' id " + std::to_string(id));
+    const FirstStep first  = first_time_step(p);
+    const double    c_el   = first.c_el, v0 = first.v0;
+    const auto     &set_by = first.set_by;
     if (!set_by.empty() && p.max_predicted_steps > 0)
       {
-        const double dt    = p.adaptive_time_step ? p.cfl * p.cell_size / (c_el + v0) : p.fixed_time_step;
-        double       steps = p.end_time / dt;
-        // An output interval below the step cuts every step to land on an output time (at
-        // least 1e-12 End time, source/simulator.cc): the outputs then set the steps.
-        const bool landing = p.output_interval > 0 && p.output_interval < dt;
-        if (landing)
-          steps = p.end_time / std::max(p.output_interval, 1e-12 * p.end_time);
-        if (p.max_steps > 0)
-          steps = std::min(steps, double(p.max_steps));
+        const double dt = first.dt, steps = first.steps;
+        const bool   landing = first.landing;
         if (landing && !(steps <= p.max_predicted_steps))
           refuse("Output/Output interval",
                  number(p.output_interval) + " s is below the first time step " + number(dt) +
@@ -492,9 +513,7 @@ namespace mpm
     // Warnings: the run goes on.
     if (p.output_interval > 0 && p.max_outputs > 0 && (p.write_grid_fields || p.write_particles))
       {
-        double outputs = std::floor(p.end_time / p.output_interval * (1 + 1e-12)) + 1;
-        if (p.max_steps > 0)
-          outputs = std::min(outputs, p.max_steps + 1.0); // at most one a step
+        const double outputs = predicted_outputs(p);
         if (outputs > p.max_outputs)
           warn_about_parameter("Output/Output interval",
                                number(p.output_interval) + " s up to Solver/End time = " + number(p.end_time) +

@@ -57,6 +57,21 @@ namespace mpm
   // outputs and of Solver/Plasticity start time after End time.
   void check_run_size(const Parameters &parameters);
 
+  // The run's first time step as check_run_size predicts it: the elastic wave speed c_el of
+  // the stiffest body (set_by names its entries; empty where no body or FEM material gives
+  // one), the largest initial speed v0, dt (adaptive: CFL x h / (c_el + v0), else the fixed
+  // step), and the steps to End time at that step (at most Maximum number of steps; landing:
+  // an Output interval below dt sets them).
+  struct FirstStep
+  {
+    double      c_el = 0, v0 = 0, dt = 0, steps = 0;
+    bool        landing = false;
+    std::string set_by;
+  };
+  FirstStep first_time_step(const Parameters &parameters);
+  // Field outputs up to End time (the initial state included; at most one a step).
+  double predicted_outputs(const Parameters &parameters);
+
   // What a run will allocate, estimated from the prm before it allocates anything.
   struct MemoryEstimate
   {
