@@ -61,6 +61,9 @@ def measure(data, wall=0.0, base=0.0, width=0.0025, fit_low=0.1, fit_high=0.9, t
         alive = data["material_id"] >= 0
     pos = data["position"][alive]
     x, y = pos[:, 0] - wall, pos[:, 1] - base
+    if "domain_half_length" not in data:
+        print("deposit.py: no domain_half_length in the data (not among Output/Particle fields?): "
+              "the surface is that of the point centres, without their domains", file=sys.stderr)
     lp = data.get("domain_half_length", np.zeros_like(data["position"]))[alive]
     top = y + lp[:, 1]
     right = x + lp[:, 0]

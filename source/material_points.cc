@@ -42,6 +42,20 @@ namespace mpm
   }
 
   template <int dim>
+  std::vector<std::string> PropertyLayout<dim>::fields(const std::vector<std::string> &state_variable_names)
+  {
+    std::vector<std::string> f = names(state_variable_names);
+    for (unsigned int c = 0; c < n_voigt; ++c)
+      {
+        f[stress + c] = "stress";
+        f[strain + c] = "strain";
+      }
+    for (unsigned int c = 0; c < dim * dim; ++c)
+      f[deformation_gradient + c] = "F";
+    return f;
+  }
+
+  template <int dim>
   std::vector<dealii::DataComponentInterpretation::DataComponentInterpretation>
   PropertyLayout<dim>::interpretations(const unsigned int n_state_variables)
   {

@@ -280,6 +280,12 @@ namespace mpm
     const auto        &p            = snapshot.points;
     const unsigned int n_properties = PropertyLayout<dim>::n_properties(p.n_state_variables());
     state_variable_names            = snapshot.labels->state_variable_names;
+    const auto fields               = PropertyLayout<dim>::fields(state_variable_names);
+    components.clear();
+    for (unsigned int c = 0; c < n_properties; ++c)
+      if (selected_fields.empty() ||
+          std::find(selected_fields.begin(), selected_fields.end(), fields[c]) != selected_fields.end())
+        components.push_back(c);
     const int          last         = end < 0 ? p.size() : end;
     unsigned int       n            = 0;
     for (int i = begin; i < last; ++i)
@@ -296,11 +302,11 @@ namespace mpm
         for (int d = 0; d < dim; ++d)
           patch.vertices[0][d] = p.position[d][i];
         patch.patch_index = k;
-        patch.data.reinit(n_properties + 1, 1);
+        patch.data.reinit(components.size() + 1, 1);
         patch.data(0, 0) = snapshot.labels->id[i];
         snapshot.properties(i, values.data());
-        for (unsigned int c = 0; c < n_properties; ++c)
-          patch.data(c + 1, 0) = values[c];
+        for (unsigned int j = 0; j < components.size(); ++j)
+          patch.data(j + 1, 0) = values[components[j]];
         ++k;
       }
   }
@@ -309,8 +315,9 @@ namespace mpm
   std::vector<std::string> PointDataOut<dim>::get_dataset_names() const
   {
     std::vector<std::string> names = {"id"};
-    for (const auto &name : PropertyLayout<dim>::names(state_variable_names))
-      names.push_back(name);
+    const auto               all   = PropertyLayout<dim>::names(state_variable_names);
+    for (const unsigned int c : components)
+      names.push_back(all[c]);
     return names;
   }
 
@@ -321,8 +328,9 @@ namespace mpm
     using namespace dealii::DataComponentInterpretation;
     const auto names = get_dataset_names();
     std::vector<DataComponentInterpretation> kinds = {component_is_scalar};
-    for (const auto kind : PropertyLayout<dim>::interpretations(state_variable_names.size()))
-      kinds.push_back(kind);
+    const auto all = PropertyLayout<dim>::interpretations(state_variable_names.size());
+    for (const unsigned int c : components)
+      kinds.push_back(all[c]);
     Ranges ranges;
     for (unsigned int i = 0; i < names.size();)
       if (kinds[i] == component_is_part_of_vector)
@@ -348,6 +356,7 @@ namespace mpm
     , write_particles(parameters.write_particles)
     , write_table(parameters.write_particle_table)
     , background(parameters.output_in_background)
+    , particle_fields(parameters.particle_fields)
     , pieces_per_rank(parameters.output_files_per_rank)
   {
     if (output_directory.empty())
@@ -503,6 +512,7 @@ namespace mpm
             writes.emplace_back([&, k]() {
               PointDataOut<dim> out;
               out.set_flags(vtk_flags);
+              out.select_fields(particle_fields);
               out.build_patches(snapshot, int(long(n) * k / K), int(long(n) * (k + 1) / K));
               write_piece(out, output_directory, "particles", counter, rank * K + k, n_ranks * K,
                           rank == 0 && k == 0, records);

@@ -1,5 +1,6 @@
 #include <mpm/dealii/guards.h>
 #include <mpm/dealii/material_library.h>
+#include <mpm/dealii/material_points.h>
 #include <mpm/dealii/method_choice.h>
 #include <mpm/dealii/parameters.h>
 
@@ -126,6 +127,30 @@ namespace mpm
     {
       AssertThrow(false, ExcMessage("Parameter '" + entry + "': " + what));
       throw; // not reached
+    }
+
+    // Output/Particle fields: each a field of the run's points (PropertyLayout::fields, whose
+    // names depend on the dimension and the models' state variables), or id or position.
+    template <int dim>
+    void check_particle_fields_of(const Parameters &p)
+    {
+      std::vector<std::string> allowed;
+      for (const std::string &field : PropertyLayout<dim>::fields(p.state_variable_names()))
+        if (std::find(allowed.begin(), allowed.end(), field) == allowed.end())
+          allowed.push_back(field);
+      for (const std::string &given : p.particle_fields)
+        if (given != "id" && given != "position" &&
+            std::find(allowed.begin(), allowed.end(), given) == allowed.end())
+          fail("Output/Particle fields", "'" + given + "' is not a field of the points. Allowed: all, or a list of " +
+                                           join(allowed) + " (id and position are always written).");
+    }
+
+    void check_particle_fields(const Parameters &p)
+    {
+      if (p.dim == 2)
+        check_particle_fields_of<2>(p);
+      else
+        check_particle_fields_of<3>(p);
     }
 
     // First pass: only what decides how the full set of entries is declared.
@@ -395,6 +420,13 @@ namespace mpm
     prm.declare_entry("Write particle table", "false", Patterns::Bool(),
                       "Also write particle_table_NNNNN.R.csv (one per output and rank R): id, position and every "
                       "property in full precision, for comparisons the single-precision .vtu files cannot resolve.");
+    prm.declare_entry("Particle fields", "all", Patterns::List(Patterns::Anything()),
+                      "The point fields written to the particle .vtu files: all, or a comma-separated list of "
+                      "mass, volume, initial_volume, velocity, stress, strain, F, domain_half_length, "
+                      "initial_domain_half_length, plastic_strain, material_id, initial_position, material_field "
+                      "and the state variables of the run's material models. The id and the position are always "
+                      "written. A 3D point carries 39 values with all; fewer fields write smaller files faster. "
+                      "The particle table (Write particle table) keeps every field.");
     prm.declare_entry("Compression", "best speed",
                       Patterns::Selection("best speed|default|best compression|no compression"),
                       "zlib compression level of the .vtu files (deal.II's VtkFlags::compression_level). best "
@@ -910,6 +942,9 @@ namespace mpm
     history_every     = prm.get_integer("History every n steps");
     progress_interval = prm.get_double("Progress interval");
     write_particle_table = prm.get_bool("Write particle table");
+    particle_fields      = dealii::Utilities::split_string_list(prm.get("Particle fields"));
+    if (particle_fields == std::vector<std::string>{"all"})
+      particle_fields.clear();
     output_compression   = prm.get("Compression");
     output_in_background = prm.get_bool("Write in background");
     output_files_per_rank = prm.get_integer("Files per rank");
@@ -998,6 +1033,7 @@ namespace mpm
     prm.enter_subsection("Resources");
     memory_limit = prm.get_double("Memory limit");
     prm.leave_subsection();
+    check_particle_fields(*this);
     check_run_size(*this);
   }
 

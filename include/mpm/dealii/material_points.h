@@ -45,6 +45,9 @@ namespace mpm
       return state_variables + n_state_variables;
     }
     static std::vector<std::string> names(const std::vector<std::string> &state_variable_names = {});
+    // The field each property belongs to, as Output/Particle fields names it: "stress" for
+    // stress_xx ... stress_xz, "strain" and "F" likewise, else the property's own name.
+    static std::vector<std::string> fields(const std::vector<std::string> &state_variable_names = {});
     static std::vector<dealii::DataComponentInterpretation::DataComponentInterpretation>
     interpretations(unsigned int n_state_variables = 0);
   };

@@ -34,6 +34,9 @@ namespace mpm
   class PointDataOut : public dealii::DataOutInterface<0, dim>
   {
   public:
+    // Only these fields (PropertyLayout::fields; Output/Particle fields) after the id; empty:
+    // every property. Call before build_patches.
+    void select_fields(const std::vector<std::string> &fields) { selected_fields = fields; }
     // Patches of the snapshot's points begin .. end - 1 (end < 0: to the last point).
     void build_patches(const PointSnapshot<dim> &snapshot, int begin = 0, int end = -1);
 
@@ -47,6 +50,8 @@ namespace mpm
   private:
     std::vector<dealii::DataOutBase::Patch<0, dim>> patches;
     std::vector<std::string>                        state_variable_names; // of the snapshot
+    std::vector<std::string>                        selected_fields;
+    std::vector<unsigned int>                       components; // the properties written, in order
   };
 
   // What the grid files show, copied when the output is asked for (MPI collective: the
@@ -188,6 +193,7 @@ namespace mpm
     unsigned int                      rank, n_ranks;
     std::string                       output_directory;
     bool                              write_grid, write_particles, write_table, background;
+    std::vector<std::string>          particle_fields; // empty: all
     unsigned int                      pieces_per_rank; // .vtu files per rank and output
     dealii::DataOutBase::VtkFlags     vtk_flags;
     unsigned int                      counter = 0;

@@ -100,6 +100,7 @@ namespace mpm
     unsigned int history_every;
     double       progress_interval;
     bool         write_particle_table;
+    std::vector<std::string> particle_fields; // Output/Particle fields: those written to the .vtu (empty: all)
     std::string  output_compression;   // zlib level of the .vtu files: "best speed", ...
     bool         output_in_background; // compress and write files on a background thread
     unsigned int output_files_per_rank; // .vtu pieces per rank and output, written in parallel
