@@ -139,7 +139,9 @@ namespace mpm
         if (std::find(allowed.begin(), allowed.end(), field) == allowed.end())
           allowed.push_back(field);
       for (const std::string &given : p.particle_fields)
-        if (given != "id" && given != "position" &&
+        if (given == "all")
+          fail("Output/Particle fields", "'all' stands alone; it cannot be combined with other fields.");
+        else if (given != "id" && given != "position" &&
             std::find(allowed.begin(), allowed.end(), given) == allowed.end())
           fail("Output/Particle fields", "'" + given + "' is not a field of the points. Allowed: all, or a list of " +
                                            join(allowed) + " (id and position are always written).");

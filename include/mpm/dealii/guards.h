@@ -69,7 +69,8 @@ namespace mpm
     std::string set_by;
   };
   FirstStep first_time_step(const Parameters &parameters);
-  // Field outputs up to End time (the initial state included; at most one a step).
+  // Field outputs up to End time: one per Output interval, the initial state included, at most
+  // one a step; with Output interval = 0 the initial and final states (one where End time = 0).
   double predicted_outputs(const Parameters &parameters);
 
   // What a run will allocate, estimated from the prm before it allocates anything.
