@@ -867,210 +867,6 @@ namespace mpm
         add_cell_pressure<Backend>(g, p, i, disconnecting);
     }
 
-    // A point's G2P kinematics in parts (grid_to_particle_kinematics below runs them in one
-    // pass, or on a backend that splits it in two: the gathers, then the update from the
-    // stored velocity gradient). First the gathers over the point's stencil and the move.
-    template <int dim, typename Shape, typename Real>
-    struct GatheredKinematics
-    {
-      Real       x[dim];                            // the centre before the move
-      Real       lp[domain_values<dim, Shape>()]; // the domain the stencil was read with
-      Real       dx[dim];                           // the point's velocity from the grid
-      Mat3<Real> L;                                 // velocity gradient; plane strain keeps row/column z zero
-      bool       leaves_grid;
-    };
-
-    template <int dim, typename Shape, typename Real>
-    MPM_HOST_DEVICE inline GatheredKinematics<dim, Shape, Real>
-    gather_and_move(const GridView<dim, Real> &g, const PointsView<dim, Real> &p, const StepSettings<dim, Real> &s,
-                    const Real dt, const bool move, const void *stencils, const int i)
-    {
-      GatheredKinematics<dim, Shape, Real> k;
-      k.L = Mat3<Real>::zero();
-      for (int d = 0; d < dim; ++d)
-        {
-          k.x[d]  = p.position[d][i];
-          k.dx[d] = Real(0);
-        }
-      load_domain<dim, Shape>(p, s, i, k.lp);
-      auto visit = [&](const int n, const Real N, const Real *grad) {
-        for (int d = 0; d < dim; ++d)
-          {
-            const Real v = g.velocity[d][n];
-            k.dx[d] += N * v;
-            for (int e = 0; e < dim; ++e)
-              k.L.a[d][e] += v * grad[e];
-          }
-      };
-      (void)stencils;
-#if defined(__CUDA_ARCH__) || defined(MPM_UNROLL_STENCIL)
-      for_each_stencil_node<dim, Shape>(g, k.x, k.lp, visit);
-#else
-      if (stencils != nullptr) // kept by P2G: the points have not moved since
-        static_cast<const HostStencil<dim, Shape, Real> *>(stencils)[i].for_each(g, visit);
-      else
-        HostStencil<dim, Shape, Real>(g, k.x, k.lp).for_each(g, visit);
-#endif
-
-      // The position first: x and dx are then dead before the constitutive update, the
-      // largest live state of the kernel (the CUDA gathers run under a register cap).
-      k.leaves_grid = false;
-      if (move)
-        for (int d = 0; d < dim; ++d)
-          {
-            const Real xn      = k.x[d] + dt * k.dx[d];
-            p.position[d][i]   = xn;
-            const Real s_local = (xn - g.origin[d]) / g.h;
-            // Also catches NaN, which compares false.
-            if (!(s_local >= Real(0) && s_local <= Real(g.n_cells[d])))
-              k.leaves_grid = true;
-          }
-      if (k.leaves_grid && s.wall_faces != 0) // a wall stops the centre on its face
-        {
-          Real xn[dim];
-          for (int d = 0; d < dim; ++d)
-            xn[d] = p.position[d][i];
-          k.leaves_grid = !stop_at_walls<dim>(s.wall_faces, g.origin, g.h, g.n_cells, xn);
-          for (int d = 0; d < dim; ++d)
-            p.position[d][i] = xn[d];
-        }
-      return k;
-    }
-
-    // Strain and spin increments, deformation gradient, volume and the constitutive update
-    // from the velocity gradient L.
-    template <int dim, DevicePhysics physics, typename Real>
-    MPM_HOST_DEVICE inline void deform_point(const PointsView<dim, Real> &p, const MaterialParameters<Real> *materials,
-                                             const StepSettings<dim, Real> &s, const Real dt, const Mat3<Real> &L,
-                                             const int i)
-    {
-      Mat3<Real> dF = Mat3<Real>::identity(), dW;
-      for (int a = 0; a < 3; ++a)
-        for (int b = 0; b < 3; ++b)
-          {
-            dF.a[a][b] += dt * L.a[a][b];
-            dW.a[a][b] = Real(0.5) * dt * (L.a[a][b] - L.a[b][a]);
-          }
-      Mat3<Real> Ldt;
-      for (int a = 0; a < 3; ++a)
-        for (int b = 0; b < 3; ++b)
-          Ldt.a[a][b] = dt * L.a[a][b];
-      const SymTensor<Real> d_eps = symmetric_part(Ldt);
-
-      StepKinematics<Real> kinematics;
-      kinematics.d_eps  = d_eps;
-      kinematics.d_spin = dW;
-      kinematics.f      = dF;
-      kinematics.J      = p.volume[i] / p.initial_volume[i]; // before the update below
-      // F <- (I + L dt) F; the volume by det(I + L dt), whose product over the steps is
-      // det F: computed from F it would lose its digits where F is far from a rotation
-      // (a point sheared along a no-slip base: entries of thousands, det F of a few, and
-      // in float none of its digits left, a negative volume; doc/methods.md).
-      if (!s.hold_points)
-        {
-          Mat3<Real> F = Mat3<Real>::identity();
-          for (int a = 0; a < dim; ++a)
-            for (int b = 0; b < dim; ++b)
-              F.a[a][b] = p.deformation_gradient[a * dim + b][i];
-          F = multiply(dF, F);
-          for (int a = 0; a < dim; ++a)
-            for (int b = 0; b < dim; ++b)
-              p.deformation_gradient[a * dim + b][i] = F.a[a][b];
-          p.volume[i] *= determinant(dF);
-        }
-      kinematics.J_new = p.volume[i] / p.initial_volume[i];
-      MaterialPointState<Real> state;
-      for (int c = 0; c < n_voigt; ++c)
-        state.stress[c] = p.stress[c][i];
-      state.plastic_strain = p.plastic_strain[i];
-#ifndef __CUDA_ARCH__
-      // A user model's state variables (CPU only: the GPU runs built-in models).
-      Real variables[max_state_variables];
-      for (int k = 0; k < p.n_state_variables; ++k)
-        variables[k] = p.state_variables[k][i];
-      if (p.n_state_variables > 0)
-        state.state_variables = variables;
-#endif
-      const MaterialParameters<Real> &material = materials[p.material[i]];
-      if (material.field_parameter == FieldParameter::none)
-        update_stress<all_physics_compiled<physics>()>(material, kinematics, state);
-      else
-        update_stress<all_physics_compiled<physics>()>(with_field_value(material, p.material_field[i]), kinematics,
-                                                       state);
-      for (int c = 0; c < n_voigt; ++c)
-        {
-          p.stress[c][i] = state.stress[c];
-          p.strain[c][i] += d_eps[c];
-        }
-      p.plastic_strain[i] = state.plastic_strain;
-#ifndef __CUDA_ARCH__
-      for (int k = 0; k < p.n_state_variables; ++k)
-        p.state_variables[k][i] = variables[k];
-#endif
-    }
-
-    // GIMP's domain rescaled from the deformation (in the pass that moves the points).
-    template <int dim, typename Real>
-    MPM_HOST_DEVICE inline void rescale_domain(const GridView<dim, Real> &g, const PointsView<dim, Real> &p,
-                                               const StepSettings<dim, Real> &s, const int i)
-    {
-      Real f[dim * dim], scale[dim];
-      for (int k = 0; k < dim * dim; ++k)
-        f[k] = p.deformation_gradient[k][i];
-      gimp_domain_scale<dim>(s.domain_update, f, p.volume[i] / p.initial_volume[i], scale);
-      for (int d = 0; d < dim; ++d)
-        {
-          // GIMP weights are valid up to half a cell.
-          const Real l = p.initial_domain_half_length[d][i] * scale[d];
-          p.domain_half_length[d][i] = l < Real(0.5) * g.h ? l : Real(0.5) * g.h;
-        }
-    }
-
-    // CPDI2q: each corner moves with the grid's velocity at it, kept as its offset from the
-    // point's rectangle: the point moved by dt dx, the corner by dt v_c.
-    template <int dim, typename Shape, typename Real>
-    MPM_HOST_DEVICE inline void move_corners(const GridView<dim, Real> &g, const PointsView<dim, Real> &p,
-                                             const StepSettings<dim, Real> &s, const Real dt,
-                                             const GatheredKinematics<dim, Shape, Real> &k, const int i)
-    {
-      for (int c = 0; c < (1 << dim); ++c)
-        {
-          Real xc[dim], vc[dim] = {};
-          for (int d = 0; d < dim; ++d)
-            xc[d] = k.x[d] + k.lp[c * dim + d];
-          visit_corner_cell<dim>(g, xc, [&](const int n, const Real N, const int *) {
-            for (int d = 0; d < dim; ++d)
-              vc[d] += N * g.velocity[d][n];
-          });
-          for (int d = 0; d < dim; ++d)
-            p.state_variables[s.corner_state_variable + c * dim + d][i] += dt * (vc[d] - k.dx[d]);
-        }
-    }
-
-    // The point removed where it left the grid, else its share of the pressure averaging's
-    // cell sums where the kinematics pass adds them.
-    template <typename Backend, int dim, typename Real>
-    MPM_HOST_DEVICE inline void finish_kinematics(const GridView<dim, Real> &g, const PointsView<dim, Real> &p,
-                                                  const int i, const bool leaves_grid, const bool scatter_pressure,
-                                                  const MaterialParameters<Real> *disconnecting)
-    {
-      if (leaves_grid)
-        p.material[i] = -1;
-      else if (scatter_pressure)
-        add_cell_pressure_atomically<Backend>(g, p, i, disconnecting);
-    }
-
-    // Backends that run the kinematics in two launches where asked (CudaBackend: the gathers
-    // wait on memory latency with few warps resident, the constitutive update needs many
-    // registers): kinematics_scratch(n, values per point) lends device memory for L.
-    template <typename Backend, typename = void>
-    struct splits_kinematics : std::false_type
-    {};
-    template <typename Backend>
-    struct splits_kinematics<Backend, std::void_t<decltype(std::declval<Backend &>().split_kinematics)>>
-      : std::true_type
-    {};
-
     // G2P kinematics from the nodal velocity field, then per point: position,
     // strain and spin increments, volume and particle domain, constitutive update.
     // A point whose centre leaves the grid is marked removed (material = -1).
@@ -1091,56 +887,161 @@ namespace mpm
         if (scatter_pressure)
           throw std::invalid_argument("grid_to_particle_kinematics: this backend scatters only in scatter_points");
       const MaterialParameters<Real> *disconnecting = disconnecting_materials(s, materials);
-      const bool                      move          = move_points && !s.hold_points;
-      if constexpr (splits_kinematics<Backend>::value)
-        if (backend.split_kinematics && deform_points)
-          {
-            // Two launches: the gathers and the move, L stored per point (dim^2 values and
-            // the leaving flag), then the rest from L. Each point's arithmetic is the one
-            // pass's; only CPDI2q's corners move before the constitutive update instead of
-            // after it (they are not read by it: the GPU runs no user model).
-            constexpr int n_values = dim * dim + 1;
-            const int     n        = p.n_points;
-            Real *const   stored   = backend.template kinematics_scratch<Real>(n, n_values);
-            backend.gather_points(n, [=] MPM_HOST_DEVICE(const int i) {
-              if (p.material[i] < 0)
-                return;
-              const auto k = gather_and_move<dim, Shape>(g, p, s, dt, move, stencils, i);
-              if constexpr (Shape::tracks_corners)
-                if (move)
-                  move_corners<dim, Shape>(g, p, s, dt, k, i);
-              for (int a = 0; a < dim; ++a)
-                for (int b = 0; b < dim; ++b)
-                  stored[(a * dim + b) * n + i] = k.L.a[a][b];
-              stored[dim * dim * n + i] = k.leaves_grid ? Real(1) : Real(0);
-            });
-            backend.gather_points(n, [=] MPM_HOST_DEVICE(const int i) {
-              if (p.material[i] < 0)
-                return;
-              Mat3<Real> L = Mat3<Real>::zero();
-              for (int a = 0; a < dim; ++a)
-                for (int b = 0; b < dim; ++b)
-                  L.a[a][b] = stored[(a * dim + b) * n + i];
-              deform_point<dim, physics>(p, materials, s, dt, L, i);
-              if (s.domain_update != DomainUpdate::none && move)
-                rescale_domain<dim>(g, p, s, i);
-              finish_kinematics<Backend>(g, p, i, stored[dim * dim * n + i] != Real(0), scatter_pressure,
-                                         disconnecting);
-            });
-            return;
-          }
       backend.gather_points(p.n_points, [=] MPM_HOST_DEVICE(const int i) {
         if (p.material[i] < 0)
           return;
-        const auto k = gather_and_move<dim, Shape>(g, p, s, dt, move, stencils, i);
+        Real x[dim], lp[domain_values<dim, Shape>()], dx[dim] = {};
+        Mat3<Real> L = Mat3<Real>::zero(); // velocity gradient; plane strain keeps row/column z zero
+        for (int d = 0; d < dim; ++d)
+          x[d] = p.position[d][i];
+        load_domain<dim, Shape>(p, s, i, lp);
+        auto visit = [&](const int n, const Real N, const Real *grad) {
+          for (int d = 0; d < dim; ++d)
+            {
+              const Real v = g.velocity[d][n];
+              dx[d] += N * v;
+              for (int e = 0; e < dim; ++e)
+                L.a[d][e] += v * grad[e];
+            }
+        };
+        (void)stencils; // captured in both compilation passes (nvcc's extended lambdas need the same captures)
+#if defined(__CUDA_ARCH__) || defined(MPM_UNROLL_STENCIL)
+        for_each_stencil_node<dim, Shape>(g, x, lp, visit);
+#else
+        if (stencils != nullptr) // kept by P2G: the points have not moved since
+          static_cast<const HostStencil<dim, Shape, Real> *>(stencils)[i].for_each(g, visit);
+        else
+          HostStencil<dim, Shape, Real>(g, x, lp).for_each(g, visit);
+#endif
+
+        // The position first: x and dx are then dead before the constitutive update, the
+        // largest live state of the kernel (the CUDA gathers run under a register cap).
+        bool       leaves_grid = false;
+        const bool move        = move_points && !s.hold_points;
+        if (move)
+          for (int d = 0; d < dim; ++d)
+            {
+              const Real xn      = x[d] + dt * dx[d];
+              p.position[d][i]   = xn;
+              const Real s_local = (xn - g.origin[d]) / g.h;
+              // Also catches NaN, which compares false.
+              if (!(s_local >= Real(0) && s_local <= Real(g.n_cells[d])))
+                leaves_grid = true;
+            }
+        if (leaves_grid && s.wall_faces != 0) // a wall stops the centre on its face
+          {
+            Real xn[dim];
+            for (int d = 0; d < dim; ++d)
+              xn[d] = p.position[d][i];
+            leaves_grid = !stop_at_walls<dim>(s.wall_faces, g.origin, g.h, g.n_cells, xn);
+            for (int d = 0; d < dim; ++d)
+              p.position[d][i] = xn[d];
+          }
+
         if (deform_points)
-          deform_point<dim, physics>(p, materials, s, dt, k.L, i);
+          {
+            Mat3<Real> dF = Mat3<Real>::identity(), dW;
+            for (int a = 0; a < 3; ++a)
+              for (int b = 0; b < 3; ++b)
+                {
+                  dF.a[a][b] += dt * L.a[a][b];
+                  dW.a[a][b] = Real(0.5) * dt * (L.a[a][b] - L.a[b][a]);
+                }
+            Mat3<Real> Ldt;
+            for (int a = 0; a < 3; ++a)
+              for (int b = 0; b < 3; ++b)
+                Ldt.a[a][b] = dt * L.a[a][b];
+            const SymTensor<Real> d_eps = symmetric_part(Ldt);
+
+            StepKinematics<Real> kinematics;
+            kinematics.d_eps  = d_eps;
+            kinematics.d_spin = dW;
+            kinematics.f      = dF;
+            kinematics.J      = p.volume[i] / p.initial_volume[i]; // before the update below
+            // F <- (I + L dt) F; the volume by det(I + L dt), whose product over the steps is
+            // det F: computed from F it would lose its digits where F is far from a rotation
+            // (a point sheared along a no-slip base: entries of thousands, det F of a few, and
+            // in float none of its digits left, a negative volume; doc/methods.md).
+            if (!s.hold_points)
+              {
+                Mat3<Real> F = Mat3<Real>::identity();
+                for (int a = 0; a < dim; ++a)
+                  for (int b = 0; b < dim; ++b)
+                    F.a[a][b] = p.deformation_gradient[a * dim + b][i];
+                F = multiply(dF, F);
+                for (int a = 0; a < dim; ++a)
+                  for (int b = 0; b < dim; ++b)
+                    p.deformation_gradient[a * dim + b][i] = F.a[a][b];
+                p.volume[i] *= determinant(dF);
+              }
+            kinematics.J_new = p.volume[i] / p.initial_volume[i];
+            MaterialPointState<Real> state;
+            for (int c = 0; c < n_voigt; ++c)
+              state.stress[c] = p.stress[c][i];
+            state.plastic_strain = p.plastic_strain[i];
+#ifndef __CUDA_ARCH__
+            // A user model's state variables (CPU only: the GPU runs built-in models).
+            Real variables[max_state_variables];
+            for (int k = 0; k < p.n_state_variables; ++k)
+              variables[k] = p.state_variables[k][i];
+            if (p.n_state_variables > 0)
+              state.state_variables = variables;
+#endif
+            const MaterialParameters<Real> &material = materials[p.material[i]];
+            if (material.field_parameter == FieldParameter::none)
+              update_stress<all_physics_compiled<physics>()>(material, kinematics, state);
+            else
+              update_stress<all_physics_compiled<physics>()>(with_field_value(material, p.material_field[i]),
+                                                             kinematics, state);
+            for (int c = 0; c < n_voigt; ++c)
+              {
+                p.stress[c][i] = state.stress[c];
+                p.strain[c][i] += d_eps[c];
+              }
+            p.plastic_strain[i] = state.plastic_strain;
+#ifndef __CUDA_ARCH__
+            for (int k = 0; k < p.n_state_variables; ++k)
+              p.state_variables[k][i] = variables[k];
+#endif
+          }
+
         if (s.domain_update != DomainUpdate::none && move)
-          rescale_domain<dim>(g, p, s, i);
+          {
+            Real f[dim * dim], scale[dim];
+            for (int k = 0; k < dim * dim; ++k)
+              f[k] = p.deformation_gradient[k][i];
+            gimp_domain_scale<dim>(s.domain_update, f, p.volume[i] / p.initial_volume[i], scale);
+            for (int d = 0; d < dim; ++d)
+              {
+                // GIMP weights are valid up to half a cell.
+                const Real l = p.initial_domain_half_length[d][i] * scale[d];
+                p.domain_half_length[d][i] = l < Real(0.5) * g.h ? l : Real(0.5) * g.h;
+              }
+          }
+
         if constexpr (Shape::tracks_corners)
           if (move)
-            move_corners<dim, Shape>(g, p, s, dt, k, i);
-        finish_kinematics<Backend>(g, p, i, k.leaves_grid, scatter_pressure, disconnecting);
+            {
+              // CPDI2q: each corner moves with the grid's velocity at it, kept as its offset from
+              // the point's rectangle: the point moved by dt dx above, the corner by dt v_c.
+              for (int c = 0; c < (1 << dim); ++c)
+                {
+                  Real xc[dim], vc[dim] = {};
+                  for (int d = 0; d < dim; ++d)
+                    xc[d] = x[d] + lp[c * dim + d];
+                  visit_corner_cell<dim>(g, xc, [&](const int n, const Real N, const int *) {
+                    for (int d = 0; d < dim; ++d)
+                      vc[d] += N * g.velocity[d][n];
+                  });
+                  for (int d = 0; d < dim; ++d)
+                    p.state_variables[s.corner_state_variable + c * dim + d][i] += dt * (vc[d] - dx[d]);
+                }
+            }
+
+        if (leaves_grid)
+          p.material[i] = -1;
+        else if (scatter_pressure)
+          add_cell_pressure_atomically<Backend>(g, p, i, disconnecting);
       });
     }
 

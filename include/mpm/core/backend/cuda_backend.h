@@ -164,28 +164,6 @@ namespace mpm
     // 3.2M points, doc/performance.md).
     int block_size = 128;
 
-    // The G2P kinematics in two launches (step.h: the gathers and the move, then the
-    // constitutive update from the velocity gradient stored per point) instead of one.
-    // MPM_CUDA_SPLIT_KINEMATICS=0/1 chooses (measuring).
-    bool split_kinematics = false;
-
-    // Device memory for `values` numbers per point (the split kinematics' velocity gradient),
-    // kept and grown as the points grow.
-    template <typename Real>
-    Real *kinematics_scratch(const int n, const int values)
-    {
-      const size_t bytes = sizeof(Real) * static_cast<size_t>(n) * static_cast<size_t>(values);
-      if (bytes > point_scratch_bytes)
-        {
-          MPM_CUDA_CHECK(cudaStreamSynchronize(stream)); // launches in flight may still read the old one
-          cudaFree(point_scratch);
-          point_scratch = nullptr;
-          MPM_CUDA_CHECK(cudaMalloc(&point_scratch, bytes));
-          point_scratch_bytes = bytes;
-        }
-      return static_cast<Real *>(point_scratch);
-    }
-
     explicit CudaBackend(const cudaStream_t stream = nullptr)
       : stream(stream)
     {
@@ -194,9 +172,6 @@ namespace mpm
       // MPM_CUDA_SYNC=1: synchronise and check after every launch (debugging, sanitizer).
       const char *sync = std::getenv("MPM_CUDA_SYNC");
       sync_every_launch = sync != nullptr && sync[0] == '1';
-      const char *split = std::getenv("MPM_CUDA_SPLIT_KINEMATICS");
-      if (split != nullptr)
-        split_kinematics = split[0] == '1';
     }
 
     CudaBackend(const CudaBackend &)            = delete;
@@ -211,7 +186,6 @@ namespace mpm
           cudaEventDestroy(e.second);
         }
       cudaFree(scratch);
-      cudaFree(point_scratch);
       cudaFreeHost(host_result);
     }
 
@@ -594,8 +568,6 @@ namespace mpm
     cudaStream_t stream;
     void        *scratch     = nullptr;
     void        *host_result = nullptr;
-    void        *point_scratch       = nullptr;
-    size_t       point_scratch_bytes = 0;
     bool         sync_every_launch = false;
 
     bool                                       timing  = false;
