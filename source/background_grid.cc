@@ -1,6 +1,7 @@
 #include <mpm/dealii/background_grid.h>
 
 #include <deal.II/base/partitioner.templates.h>
+#include <deal.II/base/quadrature_lib.h>
 #include <deal.II/base/utilities.h>
 #include <deal.II/dofs/dof_tools.h>
 #include <deal.II/grid/grid_generator.h>
@@ -76,11 +77,12 @@ namespace mpm
     return grid;
   }
 
-  unsigned int cell_partition_weight(const double n_points, const double point_weight)
+  unsigned int cell_partition_weight(const double n_points, const double point_weight,
+                                     const unsigned int n_lattice_cells)
   {
     constexpr double max_weight = std::numeric_limits<int>::max();
     const double     per_point  = std::min(std::round(16 * point_weight), max_weight);
-    return static_cast<unsigned int>(std::min(16 + per_point * n_points, max_weight));
+    return static_cast<unsigned int>(std::min(16.0 * n_lattice_cells + per_point * n_points, max_weight));
   }
 
   template <int dim>
@@ -92,7 +94,9 @@ namespace mpm
                                           std::make_unique<dealii::Triangulation<dim>>())
     , triangulation(*triangulation_storage)
     , distributed(dynamic_cast<dealii::parallel::distributed::Triangulation<dim> *>(&triangulation))
-    , fe(1)
+    , cells_per_grid_cell(parameters.cells_per_grid_cell)
+    , lattice_cells_per_grid_cell(dealii::Utilities::pow(parameters.cells_per_grid_cell, dim))
+    , fe(dealii::QIterated<1>(dealii::QTrapezoid<1>(), parameters.cells_per_grid_cell))
     , dof_handler(triangulation)
     , boundary(parameters.boundary)
   {
@@ -105,21 +109,25 @@ namespace mpm
     // p4est orders the coarse cells as given (lexicographically: a partition into
     // slabs) and the cells inside each coarse cell along a Morton curve (compact
     // blocks, fewer ghost nodes per owned node). Coarse cells of 2^levels x 2^levels
-    // lattice cells, refined globally, give the same lattice with compact partitions.
+    // deal.II cells (of k x k lattice cells each), refined globally, give the same lattice
+    // with compact partitions.
+    const int    k      = cells_per_grid_cell;
     unsigned int levels = 10;
     for (unsigned int d = 0; d < dim; ++d)
       {
         origin[d]  = lattice.origin[d];
         n_cells[d] = lattice.n_cells[d];
+        AssertThrow(n_cells[d] % k == 0, dealii::ExcMessage("Grid/Cells per deal.II cell must divide the cells "
+                                                            "along every direction."));
         unsigned int twos = 0;
-        while (twos < levels && (n_cells[d] >> twos) % 2 == 0)
+        while (twos < levels && (n_cells[d] / k >> twos) % 2 == 0)
           ++twos;
         levels = std::min(levels, twos);
         p1[d]  = parameters.lower[d];
         p2[d]  = parameters.lower[d] + n_cells[d] * h;
       }
     for (unsigned int d = 0; d < dim; ++d)
-      repetitions[d] = n_cells[d] >> levels;
+      repetitions[d] = n_cells[d] / k >> levels;
     // colorize: boundary ids 0..2dim-1 for x min, x max, y min, ...; children inherit them.
     dealii::GridGenerator::subdivided_hyper_rectangle(triangulation, repetitions, p1, p2, true);
     // Several ranks: p4est partitions the refined cells by the start points' work (the
@@ -142,7 +150,8 @@ namespace mpm
                 x[d] = points->position[d][i];
               ++points_in_cell[lattice_cell_of(x)];
             }
-        const double point_weight = parameters.point_weight;
+        const double       point_weight  = parameters.point_weight;
+        const unsigned int lattice_cells = lattice_cells_per_grid_cell;
         using CellIterator        = typename dealii::Triangulation<dim>::cell_iterator;
         using CellStatus          = typename dealii::Triangulation<dim>::CellStatus;
         // p4est partitions after each level of refine_global. deal.II asks for the weights of a
@@ -151,11 +160,12 @@ namespace mpm
         // with CELL_INVALID (taking both as children is what makes test_build_partition find
         // no cell moved). Child k is the parent's k-th corner, bit d of k set for the upper
         // half in direction d. Each gets the mean work of the lattice cells it covers (at the
-        // last level its own cell's; before, proportional to their sum without overflowing
+        // last level its own cells'; before, proportional to their sum without overflowing
         // p4est's int weights). Every child given the lattice cell at the parent's centre, as
         // before, left the build's partition unlike the repartition's (doc/log.md, 2026-12-02).
         weights = triangulation.signals.weight.connect(
-          [&points_in_cell, point_weight, this, parent = std::pair<int, int>(-1, -1), next_child = 0u](
+          [&points_in_cell, point_weight, lattice_cells, this, parent = std::pair<int, int>(-1, -1),
+           next_child = 0u](
             const CellIterator &cell, const CellStatus status) mutable -> unsigned int {
             constexpr unsigned int last_vertex = dealii::GeometryInfo<dim>::vertices_per_cell - 1;
             dealii::Point<dim>     lower = cell->vertex(0), upper = cell->vertex(last_vertex);
@@ -195,7 +205,8 @@ namespace mpm
                   index = index * n_cells[d] + at[d];
                 points += points_in_cell[index];
               }
-            return cell_partition_weight(points / n, point_weight);
+            // A deal.II cell's weight: k^dim times that mean.
+            return cell_partition_weight(points * lattice_cells / n, point_weight, lattice_cells);
           });
       }
     triangulation.refine_global(levels);
@@ -214,10 +225,94 @@ namespace mpm
         n_lattice_cells *= n_cells[d];
         n_lattice_nodes *= n_cells[d] + 1;
       }
+    const int k  = cells_per_grid_cell;
+    const int kd = lattice_cells_per_grid_cell;
 
     dof_handler.distribute_dofs(fe);
     locally_owned_dofs = dof_handler.locally_owned_dofs();
-    dealii::DoFTools::extract_locally_relevant_dofs(dof_handler, locally_relevant_dofs);
+
+    // The lattice cells: 1 in an owned deal.II cell, 2 in the one layer around those
+    // (corners included; for k = 1 p4est's ghost cells), 0 elsewhere.
+    std::vector<std::uint8_t> cell_state(n_lattice_cells, 0);
+    cell_of_lattice_cell.assign(n_lattice_cells, triangulation.end());
+    for (const auto &cell : triangulation.active_cell_iterators())
+      if (cell->is_locally_owned())
+        for_each_lattice_cell(cell, [&](const long c) {
+          cell_state[c]           = 1;
+          cell_of_lattice_cell[c] = cell;
+        });
+    auto coordinates = [&](long index, const bool of_cell, long idx[dim]) {
+      for (int d = 0; d < dim; ++d)
+        {
+          const long n = of_cell ? n_cells[d] : n_cells[d] + 1;
+          idx[d]       = index % n;
+          index /= n;
+        }
+    };
+    // Some lattice cell among the 3^dim around cell `idx` (offset -1..1) or the 2^dim around
+    // node `idx` (offset -1..0) that is owned (only_owned) or owned or in the layer.
+    auto any_around = [&](const long idx[dim], const bool of_node, const bool only_owned) {
+      const int lowest = -1, highest = of_node ? 0 : 1, width = highest - lowest + 1;
+      for (int j = 0; j < dealii::Utilities::pow(width, dim); ++j)
+        {
+          long index = 0;
+          bool in    = true;
+          for (int d = dim - 1, rest = j; d >= 0; --d)
+            {
+              const int  step = dealii::Utilities::pow(width, d);
+              const long i    = idx[d] + lowest + rest / step;
+              rest %= step;
+              in    = in && i >= 0 && i < n_cells[d];
+              index = index * n_cells[d] + (in ? i : 0);
+            }
+          if (in && (only_owned ? cell_state[index] == 1 : cell_state[index] != 0))
+            return true;
+        }
+      return false;
+    };
+    for (const auto &cell : triangulation.active_cell_iterators())
+      if (cell->is_ghost())
+        for_each_lattice_cell(cell, [&](const long c) {
+          long idx[dim];
+          coordinates(c, true, idx);
+          if (any_around(idx, false, true)) // not the cells of the layer marked so far
+            cell_state[c] = 2;
+        });
+
+    // The locally relevant nodes: every DoF of an owned cell, and those of the ghost cells
+    // that are a vertex of a lattice cell in the layer. A DoF's lattice node is its support
+    // point's.
+    const std::vector<dealii::Point<dim>>        &unit = fe.get_unit_support_points();
+    std::vector<dealii::types::global_dof_index> dofs(fe.n_dofs_per_cell());
+    std::vector<std::pair<long, dealii::types::global_dof_index>> node_dofs; // lattice node, DoF
+    for (const auto &cell : dof_handler.active_cell_iterators())
+      {
+        if (cell->is_artificial())
+          continue;
+        cell->get_dof_indices(dofs);
+        long first[dim];
+        lower_lattice_corner(cell, first);
+        for (unsigned int i = 0; i < dofs.size(); ++i)
+          {
+            long idx[dim], node = 0;
+            for (int d = dim - 1; d >= 0; --d)
+              {
+                idx[d] = first[d] + std::lround(unit[i][d] * k);
+                node   = node * (n_cells[d] + 1) + idx[d];
+              }
+            if (cell->is_locally_owned() || any_around(idx, true, false))
+              node_dofs.emplace_back(node, dofs[i]);
+          }
+      }
+    locally_relevant_dofs = locally_owned_dofs;
+    {
+      std::vector<dealii::types::global_dof_index> relevant(node_dofs.size());
+      for (std::size_t j = 0; j < node_dofs.size(); ++j)
+        relevant[j] = node_dofs[j].second;
+      std::sort(relevant.begin(), relevant.end());
+      relevant.erase(std::unique(relevant.begin(), relevant.end()), relevant.end());
+      locally_relevant_dofs.add_indices(relevant.begin(), relevant.end());
+    }
     partitioner = std::make_shared<dealii::Utilities::MPI::Partitioner>(locally_owned_dofs, locally_relevant_dofs,
                                                                        communicator);
     mass.reinit(partitioner);
@@ -229,49 +324,22 @@ namespace mpm
       }
 
     const unsigned int n_local_nodes = partitioner->locally_owned_size() + partitioner->n_ghost_indices();
-    lattice_to_node.assign(n_lattice_nodes, -1);
+    auto               node_map      = std::make_shared<std::vector<int>>(n_lattice_nodes, -1);
+    for (const auto &[node, dof] : node_dofs)
+      (*node_map)[node] = static_cast<int>(partitioner->global_to_local(dof));
+    lattice_to_node = node_map;
     fixed_components.assign(n_local_nodes, 0);
     friction_faces.assign(has_friction_face(boundary) ? n_local_nodes : 0, 0);
-    cell_of_lattice_cell.assign(n_lattice_cells, triangulation.end());
 
-    auto lattice_index = [&](const dealii::Point<dim> &x, const bool of_cell) {
-      long index = 0;
-      for (int d = dim - 1; d >= 0; --d)
-        {
-          const long i = of_cell ? static_cast<long>(std::floor((x[d] - origin[d]) / h)) :
-                                   std::lround((x[d] - origin[d]) / h);
-          index = index * (of_cell ? n_cells[d] : n_cells[d] + 1) + i;
-        }
-      return index;
-    };
-
-    // Cells for the per-cell sums of the pressure averaging: deal.II's partitioner of the
-    // global active cell indices has the owned cells and the ghost layer.
-    cell_partitioner = distributed ? distributed->global_active_cell_index_partitioner().lock() :
-                                     std::make_shared<const dealii::Utilities::MPI::Partitioner>(
-                                       triangulation.n_active_cells());
-    lattice_cell_of_local_cell_index.assign(cell_partitioner->locally_owned_size() + cell_partitioner->n_ghost_indices(),
-                                      -1);
-
-    // Owned and ghost cells: their vertices are exactly the locally relevant nodes.
+    // Boundary masks from the face ids: no-slip fixes every component, free-slip the normal
+    // one, friction marks the face in the node's friction mask. Every cell holding a boundary
+    // node has a face with that node on that boundary, so ghost nodes get the same masks as
+    // on their owner.
+    std::vector<dealii::types::global_dof_index> face_dofs(fe.n_dofs_per_face());
     for (const auto &cell : dof_handler.active_cell_iterators())
       {
         if (cell->is_artificial())
           continue;
-        lattice_cell_of_local_cell_index[cell_partitioner->global_to_local(cell->global_active_cell_index())] =
-          lattice_index(cell->center(), true);
-        if (cell->is_locally_owned())
-          cell_of_lattice_cell[lattice_index(cell->center(), true)] = cell;
-        for (const unsigned int v : cell->vertex_indices())
-          {
-            const auto global = cell->vertex_dof_index(v, 0);
-            lattice_to_node[lattice_index(cell->vertex(v), false)] =
-              static_cast<int>(partitioner->global_to_local(global));
-          }
-        // Boundary masks from the face ids: no-slip fixes every component, free-slip the normal one,
-        // friction marks the face in the node's friction mask. Every cell touching a boundary node
-        // has a face with that node on that boundary, so ghost nodes get the same masks as on their
-        // owner.
         for (const unsigned int f : cell->face_indices())
           if (cell->face(f)->at_boundary())
             {
@@ -282,15 +350,62 @@ namespace mpm
               const std::uint8_t bits = type == BoundaryType::no_slip ? std::uint8_t((1u << dim) - 1) :
                                         type == BoundaryType::free_slip ? std::uint8_t(1u << (id / 2)) :
                                                                           std::uint8_t(0);
-              for (unsigned int fv = 0; fv < dealii::GeometryInfo<dim>::vertices_per_face; ++fv)
-                {
-                  const auto node = partitioner->global_to_local(cell->face(f)->vertex_dof_index(fv, 0));
-                  fixed_components[node] |= bits;
-                  if (type == BoundaryType::friction)
-                    friction_faces[node] |= std::uint8_t(1u << id);
-                }
+              cell->face(f)->get_dof_indices(face_dofs);
+              for (const auto dof : face_dofs)
+                if (locally_relevant_dofs.is_element(dof))
+                  {
+                    const auto node = partitioner->global_to_local(dof);
+                    fixed_components[node] |= bits;
+                    if (type == BoundaryType::friction)
+                      friction_faces[node] |= std::uint8_t(1u << id);
+                  }
             }
       }
+
+    // The partitioner of the lattice cells for the per-cell sums of the pressure averaging:
+    // lattice cell s of deal.II cell c is (global active cell index of c) x k^dim + s. The
+    // owned deal.II cells' global indices are one range on each rank, so are their lattice
+    // cells'.
+    dealii::types::global_cell_index first_owned = std::numeric_limits<dealii::types::global_cell_index>::max(),
+                                     n_owned     = 0;
+    std::vector<dealii::types::global_cell_index> ghost_cells;
+    for (const auto &cell : triangulation.active_cell_iterators())
+      if (cell->is_locally_owned())
+        {
+          first_owned = std::min(first_owned, cell->global_active_cell_index());
+          ++n_owned;
+        }
+      else if (cell->is_ghost())
+        {
+          int s = 0;
+          for_each_lattice_cell(cell, [&](const long c) {
+            if (cell_state[c] == 2)
+              ghost_cells.push_back(cell->global_active_cell_index() * kd + s);
+            ++s;
+          });
+        }
+    const dealii::types::global_cell_index n_global_cells =
+      dealii::Utilities::MPI::sum<dealii::types::global_cell_index>(n_owned, communicator) * kd;
+    dealii::IndexSet owned_cells(n_global_cells), ghost_cell_set(n_global_cells);
+    if (n_owned > 0)
+      owned_cells.add_range(first_owned * kd, (first_owned + n_owned) * kd);
+    std::sort(ghost_cells.begin(), ghost_cells.end());
+    ghost_cell_set.add_indices(ghost_cells.begin(), ghost_cells.end());
+    auto cells = std::make_shared<dealii::Utilities::MPI::Partitioner>(owned_cells, ghost_cell_set, communicator);
+    lattice_cell_of_local_cell_index.assign(cells->locally_owned_size() + cells->n_ghost_indices(), -1);
+    for (const auto &cell : triangulation.active_cell_iterators())
+      if (cell->is_locally_owned() || cell->is_ghost())
+        {
+          AssertThrow(!cell->is_locally_owned() || cell->global_active_cell_index() - first_owned < n_owned,
+                      dealii::ExcInternalError()); // the owned cells' indices are one range
+          int s = 0;
+          for_each_lattice_cell(cell, [&](const long c) {
+            const dealii::types::global_cell_index global = cell->global_active_cell_index() * kd + s++;
+            if (cell_state[c] != 0)
+              lattice_cell_of_local_cell_index[cells->global_to_local(global)] = c;
+          });
+        }
+    cell_partitioner = cells;
   }
 
   template <int dim>
@@ -306,6 +421,31 @@ namespace mpm
   }
 
   template <int dim>
+  void BackgroundGrid<dim>::lower_lattice_corner(const typename dealii::Triangulation<dim>::cell_iterator &cell,
+                                                 long first[dim]) const
+  {
+    const dealii::Point<dim> lower = cell->vertex(0); // the cells are axis-parallel boxes
+    for (int d = 0; d < dim; ++d)
+      first[d] = std::lround((lower[d] - origin[d]) / h);
+  }
+
+  template <int dim>
+  long BackgroundGrid<dim>::lattice_cell_in(const typename dealii::Triangulation<dim>::cell_iterator &cell,
+                                            const double *x) const
+  {
+    long first[dim];
+    lower_lattice_corner(cell, first);
+    long index = 0;
+    for (int d = dim - 1; d >= 0; --d)
+      {
+        const long i = std::clamp(static_cast<long>(std::floor((x[d] - origin[d]) / h)), first[d],
+                                  first[d] + cells_per_grid_cell - 1);
+        index        = index * n_cells[d] + i;
+      }
+    return index;
+  }
+
+  template <int dim>
   mpm::GridView<dim, double> BackgroundGrid<dim>::view()
   {
     mpm::GridView<dim, double> v{};
@@ -318,7 +458,7 @@ namespace mpm
         v.velocity[d] = velocity[d].begin();
       }
     v.h                = h;
-    v.lattice_to_node  = lattice_to_node.data();
+    v.lattice_to_node  = lattice_to_node->data();
     v.n_nodes          = static_cast<int>(fixed_components.size());
     v.mass             = mass.begin();
     v.fixed_components = fixed_components.data();

@@ -387,12 +387,10 @@ namespace mpm
         std::vector<std::uint8_t> owned(n_lattice_cells, 0);
         for (const auto &cell : shared_grid->triangulation.active_cell_iterators())
           if (cell->is_locally_owned() || cell->is_ghost())
-            {
-              const dealii::Point<dim> centre = cell->center();
-              const long               c      = shared_grid->lattice_cell_of(&centre[0]);
-              owner_of_cell[c]                = static_cast<int>(cell->subdomain_id());
-              owned[c]                        = cell->is_locally_owned() ? 1 : 0;
-            }
+            shared_grid->for_each_lattice_cell(cell, [&](const long c) {
+              owner_of_cell[c] = static_cast<int>(cell->subdomain_id());
+              owned[c]         = cell->is_locally_owned() ? 1 : 0;
+            });
         device->set_owned_cells(owned);
       }
     };

@@ -92,12 +92,13 @@ namespace mpm
     const double point_weight = parameters.point_weight;
     this->point_weight        = (cell_partition_weight(1, point_weight) - cell_partition_weight(0, point_weight)) / 16.;
     using CellStatus          = typename dealii::Triangulation<dim>::CellStatus;
+    const unsigned int lattice_cells = grid.lattice_cells_per_grid_cell;
     weight_connection         = grid.triangulation.signals.weight.connect(
-      [this, point_weight](const typename dealii::Triangulation<dim>::cell_iterator &cell,
+      [this, point_weight, lattice_cells](const typename dealii::Triangulation<dim>::cell_iterator &cell,
                            const CellStatus status) -> unsigned int {
         // The background grid is never refined or coarsened: only CELL_PERSIST occurs.
         (void)status;
-        return cell_partition_weight(handler.n_particles_in_cell(cell), point_weight);
+        return cell_partition_weight(handler.n_particles_in_cell(cell), point_weight, lattice_cells);
       });
   }
 
@@ -520,11 +521,8 @@ namespace mpm
           }
         if (home_cells)
           {
-            const auto center = particle.get_surrounding_cell()->center();
-            double     c[dim];
-            for (int d = 0; d < dim; ++d)
-              c[d] = center[d];
-            (*home_cells)[i] = grid.lattice_cell_of(c);
+            const auto x = particle.get_location();
+            (*home_cells)[i] = grid.lattice_cell_in(particle.get_surrounding_cell(), &x[0]);
           }
         const auto x    = particle.get_location();
         const auto prop = particle.get_properties();
@@ -693,8 +691,9 @@ namespace mpm
   double MaterialPoints<dim>::imbalance(const double n_local_points) const
   {
     // The work model of the partition's cell weights: cells plus weighted points.
-    const double local = (grid.distributed ? grid.distributed->n_locally_owned_active_cells() :
-                                             grid.triangulation.n_active_cells()) +
+    const double local = double(grid.distributed ? grid.distributed->n_locally_owned_active_cells() :
+                                                   grid.triangulation.n_active_cells()) *
+                           grid.lattice_cells_per_grid_cell +
                          point_weight * n_local_points;
     const double most  = dealii::Utilities::MPI::max(local, grid.communicator);
     const double total = dealii::Utilities::MPI::sum(local, grid.communicator);

@@ -138,6 +138,17 @@ namespace mpm
     for (const auto &cell : grid.dof_handler.active_cell_iterators())
       if (cell->is_locally_owned())
         cells.push_back(cell);
+    cells_per_grid_cell = grid.cells_per_grid_cell;
+    if (cells_per_grid_cell > 1)
+      {
+        lattice_to_node = grid.lattice_node_map();
+        h               = grid.h;
+        for (int d = 0; d < dim; ++d)
+          {
+            origin[d]          = grid.origin[d];
+            n_lattice_cells[d] = grid.n_cells[d];
+          }
+      }
     nodal.push_back(grid.mass);
     for (int d = 0; d < dim; ++d)
       nodal.push_back(grid.velocity[d]);
@@ -244,6 +255,37 @@ namespace mpm
         return;
       }
     const unsigned int n_nodal = snapshot.nodal.size();
+    if (snapshot.cells_per_grid_cell > 1) // a patch per lattice cell, its deal.II cell's in turn
+      {
+        const int k = snapshot.cells_per_grid_cell, per_cell = dealii::Utilities::pow(k, dim);
+        for (int c = begin; c < last; ++c)
+          {
+            const auto              &cell  = snapshot.cells[c / per_cell];
+            const dealii::Point<dim> lower = cell->vertex(0);
+            int                      first[dim];
+            for (int d = 0, rest = c % per_cell; d < dim; ++d, rest /= k)
+              first[d] = static_cast<int>(std::lround((lower[d] - snapshot.origin[d]) / snapshot.h)) + rest % k;
+            auto &patch          = patches[c - begin];
+            patch.patch_index    = c - begin;
+            patch.reference_cell = dealii::ReferenceCells::get_hypercube<dim>();
+            patch.data.reinit(n_nodal + 1, n_vertices);
+            for (unsigned int v = 0; v < n_vertices; ++v)
+              {
+                long node = 0;
+                for (int d = dim - 1; d >= 0; --d)
+                  {
+                    const int i          = first[d] + ((v >> d) & 1);
+                    patch.vertices[v][d] = snapshot.origin[d] + i * snapshot.h;
+                    node                 = node * (snapshot.n_lattice_cells[d] + 1) + i;
+                  }
+                const int local = (*snapshot.lattice_to_node)[node];
+                for (unsigned int f = 0; f < n_nodal; ++f)
+                  patch.data(f, v) = snapshot.nodal[f].local_element(local);
+                patch.data(n_nodal, v) = snapshot.rank;
+              }
+          }
+        return;
+      }
     for (int c = begin; c < last; ++c)
       {
         const auto &cell  = snapshot.cells[c];

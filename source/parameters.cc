@@ -198,6 +198,13 @@ namespace mpm
     prm.declare_entry("Active block size", "4", Patterns::Integer(1, 64),
                       "Nodes = near material: edge of the blocks, in cells. Every cell within this many cells "
                       "of a point's cell is kept; larger blocks choose the nodes less often but keep more.");
+    prm.declare_entry("Cells per deal.II cell", "1", Patterns::Integer(1, 16),
+                      "Edge k of deal.II's cells of the background grid, in cells of Cell size: deal.II's grid has "
+                      "k^dim times fewer cells, and its Q_k elements with equidistant nodes put a degree of "
+                      "freedom at every node of the MPM grid, so the step, its nodes and its results are the "
+                      "same. Building deal.II's grid (on several ranks before the first step) is then much "
+                      "faster, and the partition among ranks moves whole deal.II cells. Each extent of the grid "
+                      "must be a multiple of k cells.");
     prm.leave_subsection();
 
     prm.enter_subsection("Boundary conditions");
@@ -576,6 +583,15 @@ namespace mpm
                                    " m) is not a whole number of cells of size " + prm.get("Cell size") + ".");
       }
     active_block_cells = prm.get("Nodes") == "near material" ? prm.get_integer("Active block size") : 0;
+    cells_per_grid_cell = prm.get_integer("Cells per deal.II cell");
+    for (unsigned int d = 0; d < dim; ++d)
+      {
+        const long n = std::lround((upper[d] - lower[d]) / cell_size);
+        if (n % cells_per_grid_cell != 0)
+          fail("Grid/Cells per deal.II cell",
+               "must divide the number of cells along every direction; " + std::string(axis_names[d]) + " has " +
+                 std::to_string(n) + " cells, not a multiple of " + std::to_string(cells_per_grid_cell) + ".");
+      }
     prm.leave_subsection();
 
     prm.enter_subsection("Boundary conditions");

@@ -3,7 +3,8 @@
 // each level of the global refinement, and deal.II asks for the weight of each child of a cell
 // being refined with the parent's iterator; the grid must give each child its own cells' work.
 // Points piled unevenly (denser towards one corner, empty elsewhere), 2D and 3D, coarse cells
-// refined from one coarse cell (6 levels in 2D, 4 in 3D); run on 2 and 3 ranks.
+// refined from one coarse cell (6 levels in 2D, 4 in 3D), and deal.II cells of several lattice
+// cells (Grid/Cells per deal.II cell: 4 in 2D, 2 in 3D); run on 2 and 3 ranks.
 #include <mpm/dealii/background_grid.h>
 
 #include <deal.II/base/mpi.h>
@@ -25,20 +26,18 @@ namespace
     std::vector<long> cells;
     for (const auto &cell : grid.triangulation.active_cell_iterators())
       if (cell->is_locally_owned())
-        {
-          const Point<dim> c = cell->center();
-          cells.push_back(grid.lattice_cell_of(&c[0]));
-        }
+        grid.for_each_lattice_cell(cell, [&](const long c) { cells.push_back(c); });
     std::sort(cells.begin(), cells.end());
     return cells;
   }
 
   // Returns the number of cells that changed owner (summed over ranks).
   template <int dim>
-  unsigned int cells_moved_by_repartition(const unsigned int cells_per_direction)
+  unsigned int cells_moved_by_repartition(const unsigned int cells_per_direction, const int cells_per_grid_cell = 1)
   {
     mpm::Parameters p          = mpm_test::box_domain<dim>(1.0, 1.0 / cells_per_direction);
     p.load_balance_threshold   = 1.02;
+    p.cells_per_grid_cell      = cells_per_grid_cell;
     const double point_weight  = p.point_weight;
     // A pile: in the lattice cells with x_0 + x_1 < 1 (the others empty), more points towards
     // the origin, away from the cells' faces (each point's cell is unambiguous).
@@ -81,8 +80,9 @@ namespace
     auto connection = grid.triangulation.signals.weight.connect(
       [&](const typename Triangulation<dim>::cell_iterator &cell,
           const typename Triangulation<dim>::CellStatus) -> unsigned int {
-        const Point<dim> c = cell->center();
-        return mpm::cell_partition_weight(points_in_cell[grid.lattice_cell_of(&c[0])], point_weight);
+        unsigned int in_cell = 0;
+        grid.for_each_lattice_cell(cell, [&](const long c) { in_cell += points_in_cell[c]; });
+        return mpm::cell_partition_weight(in_cell, point_weight, grid.lattice_cells_per_grid_cell);
       });
     grid.distributed->repartition();
     connection.disconnect();
@@ -94,7 +94,8 @@ namespace
     const unsigned int moved = Utilities::MPI::sum(static_cast<unsigned int>(changed.size()), MPI_COMM_WORLD) / 2;
     const unsigned int cells = Utilities::MPI::sum(static_cast<unsigned int>(built.size()), MPI_COMM_WORLD);
     if (Utilities::MPI::this_mpi_process(MPI_COMM_WORLD) == 0)
-      std::cout << dim << "D, " << cells << " cells, " << points.size() << " points: " << moved
+      std::cout << dim << "D, " << cells << " cells (deal.II cells of " << grid.lattice_cells_per_grid_cell
+                << "), " << points.size() << " points: " << moved
                 << " cells change rank in a repartition after the build" << std::endl;
     return moved;
   }
@@ -111,6 +112,8 @@ int main(int argc, char **argv)
   unsigned int moved = 0;
   moved += cells_moved_by_repartition<2>(64); // one coarse cell refined 6 times
   moved += cells_moved_by_repartition<3>(16); // 4 times
+  moved += cells_moved_by_repartition<2>(64, 4); // one coarse cell of 16 x 16 deal.II cells of 4 x 4
+  moved += cells_moved_by_repartition<3>(16, 2); // 8^3 deal.II cells of 2^3
   if (Utilities::MPI::this_mpi_process(MPI_COMM_WORLD) == 0)
     std::cout << (moved == 0 ? "ok" : "FAILED") << std::endl;
   return moved == 0 ? 0 : 1;

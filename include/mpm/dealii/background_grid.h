@@ -1,13 +1,16 @@
 // The background grid as deal.II sees it: a triangulation of a uniform Cartesian box
-// (p4est on several ranks, a serial one on one rank), a Q1 DoFHandler whose vertex DoFs are the MPM nodes, nodal fields
-// as distributed vectors over the locally relevant DoFs, and the lattice lookup and
-// boundary masks that the core's GridView reads.
+// (p4est on several ranks, a serial one on one rank) whose cells are k x k (x k) MPM cells
+// (Grid/Cells per deal.II cell, k = 1 by default), a Q_k DoFHandler with equidistant
+// support points, so that its DoFs are exactly the MPM nodes, nodal fields as distributed
+// vectors over the locally relevant nodes, and the lattice lookup and boundary masks that
+// the core's GridView reads. "Lattice cell" below is an MPM cell.
 //
 // In parallel, each rank's node arrays hold its locally relevant nodes: the vertices
-// of its locally owned cells and of the one layer of ghost cells around them (p4est's
-// ghost layer includes corner neighbours). A point whose centre lies in an owned cell,
-// or less than half a cell outside one, has its whole GIMP (and linear) stencil in this
-// set; the step loop keeps every point within that distance (doc/performance.md, MPI).
+// of the lattice cells in its locally owned deal.II cells and of the one layer of lattice
+// cells around them, corners included (for k = 1 p4est's ghost layer; for k > 1 the part of
+// it next to the owned cells). A point whose centre lies in an owned lattice cell, or less
+// than half a cell outside one, has its whole GIMP (and linear) stencil in this set; the
+// step loop keeps every point within that distance (doc/performance.md, MPI).
 #pragma once
 
 #include <mpm/core/host_storage.h>
@@ -47,7 +50,8 @@ namespace mpm
   // units. Integer weights: scaled by 16 so that fractional point weights keep their
   // meaning. p4est reads each cell's weight as an int: capped there (a Point weight of 1e9
   // wrapped around to a negative weight, and p4est's partition aborted).
-  unsigned int cell_partition_weight(double n_points, double point_weight);
+  // A deal.II cell of n_lattice_cells lattice cells costs that many units.
+  unsigned int cell_partition_weight(double n_points, double point_weight, unsigned int n_lattice_cells = 1);
 
   template <int dim>
   class BackgroundGrid
@@ -73,6 +77,26 @@ namespace mpm
 
     // Lattice cell index of the cell containing x (clamped to the grid).
     long lattice_cell_of(const double *x) const;
+
+    // The lattice cell containing x among those of deal.II cell `cell` (x clamped to it): a
+    // point's home cell after the ParticleHandler sorted it into `cell`.
+    long lattice_cell_in(const typename dealii::Triangulation<dim>::cell_iterator &cell, const double *x) const;
+
+    // Calls f(lattice cell index) for each of the k^dim lattice cells of deal.II cell `cell`.
+    template <typename F>
+    void for_each_lattice_cell(const typename dealii::Triangulation<dim>::cell_iterator &cell, F f) const
+    {
+      long first[dim];
+      lower_lattice_corner(cell, first);
+      const int k = cells_per_grid_cell;
+      for (int s = 0; s < lattice_cells_per_grid_cell; ++s)
+        {
+          long index = 0;
+          for (int d = dim - 1; d >= 0; --d)
+            index = index * n_cells[d] + first[d] + (d == 0 ? s % k : d == 1 ? s / k % k : s / (k * k));
+          f(index);
+        }
+    }
 
     mpm::GridView<dim, double> view();
 
@@ -126,7 +150,10 @@ namespace mpm
     std::unique_ptr<dealii::Triangulation<dim>>        triangulation_storage;
     dealii::Triangulation<dim>                        &triangulation;
     dealii::parallel::distributed::Triangulation<dim> *distributed; // null on one rank
-    dealii::FE_Q<dim>                         fe;
+    // Edge of a deal.II cell in lattice cells (k), and k^dim.
+    int                                       cells_per_grid_cell;
+    int                                       lattice_cells_per_grid_cell;
+    dealii::FE_Q<dim>                         fe; // Q_k, support points at the lattice nodes
     dealii::DoFHandler<dim>                   dof_handler;
     // The cells are axis-parallel cubes: real <-> unit coordinates are a shift and a
     // scaling, not MappingQ1's Newton iteration (point generation and every re-sort of
@@ -142,9 +169,15 @@ namespace mpm
     // Nodal fields; their local storage (owned, then ghosts) is the core's node array.
     Vector mass, momentum[dim], force[dim], velocity[dim];
 
-    // The triangulation's partitioner of global active cell indices: locally owned
-    // cells, then the ghost cells (the one layer around them, corners included).
+    // The partitioner of the lattice cells, numbered (global active cell index) x k^dim +
+    // (the lattice cell's place in its deal.II cell, x fastest): the locally owned ones,
+    // then the ghost ones (the one layer around them, corners included). For k = 1 the
+    // triangulation's partitioner of global active cell indices.
     std::shared_ptr<const dealii::Utilities::MPI::Partitioner> cell_partitioner;
+
+    // Local node index of each lattice node (-1 where this rank holds none). Replaced, not
+    // changed, when the nodes are distributed again: an output being written keeps its own.
+    std::shared_ptr<const std::vector<int>> lattice_node_map() const { return lattice_to_node; }
 
   private:
     template <typename Real>
@@ -160,8 +193,11 @@ namespace mpm
     // Lattice cell index of each owned and ghost cell, in the cell partitioner's local order.
     std::vector<long> lattice_cell_of_local_cell_index;
 
+    // Lattice index (along each direction) of the lower corner of deal.II cell `cell`.
+    void lower_lattice_corner(const typename dealii::Triangulation<dim>::cell_iterator &cell, long first[dim]) const;
+
     std::array<BoundaryType, 6> boundary;
-    std::vector<int>          lattice_to_node;
+    std::shared_ptr<std::vector<int>> lattice_to_node;
     std::vector<std::uint8_t> fixed_components;
     std::vector<std::uint8_t> friction_faces;            // empty without a friction face
     double                    friction_coefficient[6] = {}; // by boundary id

@@ -78,8 +78,18 @@ namespace mpm
     std::vector<typename BackgroundGrid<dim>::Vector>                   nodal; // mass, velocity_x, ...
     LatticeCells                                                         lattice_cells; // used where cells is empty
     float                                                                rank = 0;
+    // Grid/Cells per deal.II cell k > 1: a patch per lattice cell of each deal.II cell, its
+    // vertices' values found through the grid's lattice lookup of the snapshot's time.
+    int                                     cells_per_grid_cell = 1;
+    std::shared_ptr<const std::vector<int>> lattice_to_node;
+    double                                  origin[dim] = {}, h = 0;
+    int                                     n_lattice_cells[dim] = {};
 
-    int n_cells() const { return static_cast<int>(cells.empty() ? lattice_cells.lower_corner.size() : cells.size()); }
+    int n_cells() const
+    {
+      return static_cast<int>(cells.empty() ? lattice_cells.lower_corner.size() :
+                                              cells.size() * dealii::Utilities::pow(cells_per_grid_cell, dim));
+    }
   };
 
   // The cells of a grid that keeps only the nodes near the material (`nodes`: its

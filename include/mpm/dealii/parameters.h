@@ -49,6 +49,7 @@ namespace mpm
     std::vector<double> lower, upper;
     double              cell_size;
     int                 active_block_cells = 0; // Nodes = near material: block edge in cells; 0: all nodes
+    int                 cells_per_grid_cell = 1; // edge of deal.II's cells in MPM cells
     std::array<BoundaryType, 6> boundary{}; // by boundary id: x min, x max, y min, y max, z min, z max
     double                      friction_coefficient = 0; // mu of every face of type friction
 
