@@ -2,7 +2,7 @@
 # Kill and resume: the reduced V3 collapse (collapse_small_2d.prm, 0.3 s, about 2,600 steps,
 # a checkpoint every 100 steps) is killed while it runs and continued with --resume; its
 # final particle table must be that of the same run left alone.
-#   checkpoint_kill.sh EXE OUTDIR NP_RUN NP_RESUME SIGNAL [BACKEND] [NODES] [PRECISION]
+#   checkpoint_kill.sh EXE OUTDIR NP_RUN NP_RESUME SIGNAL [BACKEND] [NODES] [PRECISION] [CELLS]
 # SIGNAL KILL: killed with SIGKILL (every rank at once, as a lost node) once a random
 # checkpoint (step 300-1500) is written; the resumed run continues from the newest complete
 # checkpoint. Same ranks: bit-identical particle tables and time steps; other ranks: equal
@@ -20,8 +20,10 @@
 # not reproducible to the bit (atomic sums in varying order); with cuda and float the resumed
 # run may differ at 0.3 s by as much as the scene in double differs from it in float on the
 # same ranks (the bound of the float np tests, mpi_collapse_float.sh; doc/checkpoints.md).
+# CELLS (Grid/Cells per deal.II cell, default 1): the resumed run builds deal.II cells of that many
+# MPM cells again and inserts the saved points into them.
 set -eu
-exe=$1 out=$2 np_run=$3 np_resume=$4 signal=$5 backend=${6:-cpu} nodes=${7:-all} precision=${8:-double}
+exe=$1 out=$2 np_run=$3 np_resume=$4 signal=$5 backend=${6:-cpu} nodes=${7:-all} precision=${8:-double} cells=${9:-1}
 if [ "$backend" = cuda ] && ! nvidia-smi -L >/dev/null 2>&1; then echo "no CUDA device: skipped"; exit 77; fi
 here=$(cd "$(dirname "$0")" && pwd)
 # numpy for compare_np.py: Debian's python3 (CI), else the first on PATH (GPU hosts)
@@ -35,7 +37,7 @@ sed -e "s/set End time *= .*/set End time = $end_time/" \
     "$here/collapse_small_2d.prm" > "$prm"
 printf '%s\n' "subsection Checkpoint" "  set Step interval = 100" "  set Number kept = 3" "end" \
   "subsection Parallel" "  set Load balance threshold = 1.02" "end" \
-  "subsection Backend" "  set Backend = $backend" "  set Precision = $precision" "end" "subsection Grid" "  set Nodes = $nodes" "end" >> "$prm"
+  "subsection Backend" "  set Backend = $backend" "  set Precision = $precision" "end" "subsection Grid" "  set Nodes = $nodes" "  set Cells per deal.II cell = $cells" "end" >> "$prm"
 launch() { # NP ARGS...: the executable on NP ranks
   local np=$1; shift
   if [ "$np" -gt 1 ]; then mpirun --oversubscribe -np "$np" "$exe" "$@"; else "$exe" "$@"; fi
