@@ -561,6 +561,10 @@ namespace mpm
             << (parameters.single_precision ? " in float" : "") << "\n"
             << "  elastic wave speed " << c_el << " m/s, end time " << parameters.end_time << " s, output in '"
             << output->directory() << "'" << std::endl;
+      if (parameters.cells_per_grid_cell > 1)
+        pcout << "  deal.II's grid: " << n_cells / dealii::Utilities::pow(parameters.cells_per_grid_cell, dim)
+              << " cells of " << parameters.cells_per_grid_cell << "^" << dim << " (Grid/Cells per deal.II cell)"
+              << std::endl;
       if (engine->follows_material())
         pcout << "  nodes near the material: " << engine->n_active_nodes() << " of the " << n_nodes
               << " (blocks of " << parameters.active_block_cells << " cells), chosen again once a point is more than "
