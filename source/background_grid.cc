@@ -241,12 +241,11 @@ namespace mpm
           cell_state[c]           = 1;
           cell_of_lattice_cell[c] = cell;
         });
-    auto coordinates = [&](long index, const bool of_cell, long idx[dim]) {
+    auto cell_coordinates = [&](long index, long idx[dim]) {
       for (int d = 0; d < dim; ++d)
         {
-          const long n = of_cell ? n_cells[d] : n_cells[d] + 1;
-          idx[d]       = index % n;
-          index /= n;
+          idx[d] = index % n_cells[d];
+          index /= n_cells[d];
         }
     };
     // Some lattice cell among the 3^dim around cell `idx` (offset -1..1) or the 2^dim around
@@ -274,45 +273,46 @@ namespace mpm
       if (cell->is_ghost())
         for_each_lattice_cell(cell, [&](const long c) {
           long idx[dim];
-          coordinates(c, true, idx);
+          cell_coordinates(c, idx);
           if (any_around(idx, false, true)) // not the cells of the layer marked so far
             cell_state[c] = 2;
         });
 
     // The locally relevant nodes: every DoF of an owned cell, and those of the ghost cells
-    // that are a vertex of a lattice cell in the layer. A DoF's lattice node is its support
-    // point's.
+    // that are a vertex of a lattice cell in the layer (for k = 1 all of them: deal.II's
+    // locally relevant DoFs). A DoF's lattice node is its support point's.
     const std::vector<dealii::Point<dim>>        &unit = fe.get_unit_support_points();
     std::vector<dealii::types::global_dof_index> dofs(fe.n_dofs_per_cell());
-    std::vector<std::pair<long, dealii::types::global_dof_index>> node_dofs; // lattice node, DoF
-    for (const auto &cell : dof_handler.active_cell_iterators())
+    // Calls f(DoF, lattice node) for each relevant DoF of non-artificial cell `cell`.
+    auto for_each_relevant_dof = [&](const auto &cell, const auto &f) {
+      cell->get_dof_indices(dofs);
+      long first[dim];
+      lower_lattice_corner(cell, first);
+      for (unsigned int i = 0; i < dofs.size(); ++i)
+        {
+          long idx[dim], node = 0;
+          for (int d = dim - 1; d >= 0; --d)
+            {
+              idx[d] = first[d] + std::lround(unit[i][d] * k);
+              node   = node * (n_cells[d] + 1) + idx[d];
+            }
+          if (k == 1 || cell->is_locally_owned() || any_around(idx, true, false))
+            f(dofs[i], node);
+        }
+    };
+    if (k == 1)
+      dealii::DoFTools::extract_locally_relevant_dofs(dof_handler, locally_relevant_dofs);
+    else
       {
-        if (cell->is_artificial())
-          continue;
-        cell->get_dof_indices(dofs);
-        long first[dim];
-        lower_lattice_corner(cell, first);
-        for (unsigned int i = 0; i < dofs.size(); ++i)
-          {
-            long idx[dim], node = 0;
-            for (int d = dim - 1; d >= 0; --d)
-              {
-                idx[d] = first[d] + std::lround(unit[i][d] * k);
-                node   = node * (n_cells[d] + 1) + idx[d];
-              }
-            if (cell->is_locally_owned() || any_around(idx, true, false))
-              node_dofs.emplace_back(node, dofs[i]);
-          }
+        dealii::DoFTools::extract_locally_active_dofs(dof_handler, locally_relevant_dofs); // the owned cells'
+        std::vector<dealii::types::global_dof_index> layer;
+        for (const auto &cell : dof_handler.active_cell_iterators())
+          if (cell->is_ghost())
+            for_each_relevant_dof(cell, [&](const auto dof, long) { layer.push_back(dof); });
+        std::sort(layer.begin(), layer.end());
+        layer.erase(std::unique(layer.begin(), layer.end()), layer.end());
+        locally_relevant_dofs.add_indices(layer.begin(), layer.end());
       }
-    locally_relevant_dofs = locally_owned_dofs;
-    {
-      std::vector<dealii::types::global_dof_index> relevant(node_dofs.size());
-      for (std::size_t j = 0; j < node_dofs.size(); ++j)
-        relevant[j] = node_dofs[j].second;
-      std::sort(relevant.begin(), relevant.end());
-      relevant.erase(std::unique(relevant.begin(), relevant.end()), relevant.end());
-      locally_relevant_dofs.add_indices(relevant.begin(), relevant.end());
-    }
     partitioner = std::make_shared<dealii::Utilities::MPI::Partitioner>(locally_owned_dofs, locally_relevant_dofs,
                                                                        communicator);
     mass.reinit(partitioner);
@@ -325,8 +325,11 @@ namespace mpm
 
     const unsigned int n_local_nodes = partitioner->locally_owned_size() + partitioner->n_ghost_indices();
     auto               node_map      = std::make_shared<std::vector<int>>(n_lattice_nodes, -1);
-    for (const auto &[node, dof] : node_dofs)
-      (*node_map)[node] = static_cast<int>(partitioner->global_to_local(dof));
+    for (const auto &cell : dof_handler.active_cell_iterators())
+      if (!cell->is_artificial())
+        for_each_relevant_dof(cell, [&](const auto dof, const long node) {
+          (*node_map)[node] = static_cast<int>(partitioner->global_to_local(dof));
+        });
     lattice_to_node = node_map;
     fixed_components.assign(n_local_nodes, 0);
     friction_faces.assign(has_friction_face(boundary) ? n_local_nodes : 0, 0);
