@@ -91,11 +91,11 @@ namespace mpm
     // The cell weights of the load balance: cell_partition_weight (background_grid.h).
     const double point_weight = parameters.point_weight;
     this->point_weight        = (cell_partition_weight(1, point_weight) - cell_partition_weight(0, point_weight)) / 16.;
-    using CellStatus          = typename dealii::Triangulation<dim>::CellStatus;
+    using CellStatus                 = typename dealii::Triangulation<dim>::CellStatus;
     const unsigned int lattice_cells = grid.lattice_cells_per_grid_cell;
-    weight_connection         = grid.triangulation.signals.weight.connect(
+    weight_connection                = grid.triangulation.signals.weight.connect(
       [this, point_weight, lattice_cells](const typename dealii::Triangulation<dim>::cell_iterator &cell,
-                           const CellStatus status) -> unsigned int {
+                                          const CellStatus status) -> unsigned int {
         // The background grid is never refined or coarsened: only CELL_PERSIST occurs.
         (void)status;
         return cell_partition_weight(handler.n_particles_in_cell(cell), point_weight, lattice_cells);
@@ -519,13 +519,10 @@ namespace mpm
             for (int d = 0; d < dim; ++d)
               labels->initial_position[d][i] = particle.get_properties()[Layout::initial_position + d];
           }
-        if (home_cells)
-          {
-            const auto x = particle.get_location();
-            (*home_cells)[i] = grid.lattice_cell_in(particle.get_surrounding_cell(), &x[0]);
-          }
         const auto x    = particle.get_location();
         const auto prop = particle.get_properties();
+        if (home_cells)
+          (*home_cells)[i] = grid.lattice_cell_in(particle.get_surrounding_cell(), &x[0]);
         for (int d = 0; d < dim; ++d)
           {
             p.position[d][i]                   = x[d];
