@@ -13,16 +13,6 @@ tests=$here/../tests/prm
 . "$here/gpu_unpack_build.sh"
 prepare_mpi_runs "${BIN:-build-cuda/dev}" "$out"
 failed=0
-check() { # NAME LIMIT COMMAND...
-  local name=$1 limit=$2 start rc
-  shift 2
-  start=$(date +%s)
-  timeout "$limit" "$@" >"$out/$name.log" 2>&1
-  rc=$?
-  echo "== $name: rc $rc ($(($(date +%s) - start)) s)"
-  grep -E "largest|FAILED|migrated|repartition|ok" "$out/$name.log" | tail -8 | cut -c1-300
-  [ $rc = 0 ] || failed=1
-}
 cuda=("subsection Backend" "  set Backend = cuda" "end")
 export MPM_VERIFY_DRIFT_BOUND=1
 check collapse_2d_k4 240 bash "$tests/mpi_collapse.sh" "$exe" "$here/.." /tmp/c2d-k4 "${cuda[@]}" \

@@ -17,17 +17,6 @@ tests=$here/../tests/prm
 . "$here/gpu_unpack_build.sh"
 prepare_mpi_runs "${BIN:-build-cuda/dev}" "$out"
 failed=0
-# check NAME LIMIT COMMAND...: runs it, logs to OUT/NAME.log, prints rc, time and the log's last lines
-check() {
-  local name=$1 limit=$2 start rc
-  shift 2
-  start=$(date +%s)
-  timeout "$limit" "$@" >"$out/$name.log" 2>&1
-  rc=$?
-  echo "== $name: rc $rc ($(($(date +%s) - start)) s)"
-  grep -E "largest|FAILED|migrated|repartition|ok" "$out/$name.log" | tail -8 | cut -c1-300
-  [ $rc = 0 ] || failed=1
-}
 check mpi_cuda 360 bash "$tests/mpi_cuda.sh" "$exe" "$here/.." /tmp/mpi_cuda
 for case in "1 1 double" "2 1 double" "1 1 float" "2 1 float"; do
   set -- $case

@@ -29,3 +29,16 @@ prepare_mpi_runs() {
   exe=$(readlink -f "$1/dealii-mpm")
   export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
 }
+
+# check NAME LIMIT COMMAND...: runs it, logs to $out/NAME.log, prints rc, time and the log's last lines, and
+# sets failed=1 where it fails (the caller sets out and failed=0).
+check() {
+  local name=$1 limit=$2 start rc
+  shift 2
+  start=$(date +%s)
+  timeout "$limit" "$@" >"$out/$name.log" 2>&1
+  rc=$?
+  echo "== $name: rc $rc ($(($(date +%s) - start)) s)"
+  grep -E "largest|FAILED|migrated|repartition|ok" "$out/$name.log" | tail -8 | cut -c1-300
+  [ $rc = 0 ] || failed=1
+}
