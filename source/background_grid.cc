@@ -19,6 +19,16 @@ namespace mpm
       return std::find(boundary.begin(), boundary.end(), BoundaryType::friction) != boundary.end();
     }
 
+    // Parameters::cells_per_grid_cell, refused (before FE_Q is built from it) outside the prm's 1..16:
+    // a library user may fill Parameters without the prm.
+    int checked_cells_per_grid_cell(const int k)
+    {
+      AssertThrow(k >= 1 && k <= 16, dealii::ExcMessage("Grid/Cells per deal.II cell (Parameters::cells_per_grid_cell) "
+                                                        "must be an integer from 1 to 16, got " + std::to_string(k) +
+                                                        "."));
+      return k;
+    }
+
     // mu of boundary id `id` (0 unless the face is friction).
     double face_friction_coefficient(const Parameters &parameters, const unsigned int id)
     {
@@ -94,9 +104,9 @@ namespace mpm
                                           std::make_unique<dealii::Triangulation<dim>>())
     , triangulation(*triangulation_storage)
     , distributed(dynamic_cast<dealii::parallel::distributed::Triangulation<dim> *>(&triangulation))
-    , cells_per_grid_cell(parameters.cells_per_grid_cell)
+    , cells_per_grid_cell(checked_cells_per_grid_cell(parameters.cells_per_grid_cell))
     , lattice_cells_per_grid_cell(dealii::Utilities::pow(parameters.cells_per_grid_cell, dim))
-    , fe(dealii::QIterated<1>(dealii::QTrapezoid<1>(), parameters.cells_per_grid_cell))
+    , fe(dealii::QIterated<1>(dealii::QTrapezoid<1>(), cells_per_grid_cell))
     , dof_handler(triangulation)
     , boundary(parameters.boundary)
   {
