@@ -43,8 +43,7 @@ else()
     stability/flip_noise/cpgimp_u_hencky 15
     prm/method_auto_v3 14
     prm/prefailure_end_to_end_2d 14
-    prm/checkpoint/KILL_np2_resume_np2 14
-    prm/checkpoint/KILL_np2_resume_np1 14
+    prm/checkpoint/KILL_np2_resume_np2_and_np1 20
     prm/smoke/granular_collapse_3d 13
     prm/collapse_small_2d_float_settled_np2 13
     prm/mpi/column_v6_friction_np12 13

@@ -3,6 +3,8 @@
 # a checkpoint every 100 steps) is killed while it runs and continued with --resume; its
 # final particle table must be that of the same run left alone.
 #   checkpoint_kill.sh EXE OUTDIR NP_RUN NP_RESUME SIGNAL [BACKEND] [NODES] [PRECISION] [CELLS]
+# NP_RESUME may be a list ("2,1"): the stopped run is copied and each copy resumed on one of the
+# rank counts from the same checkpoint, so the runs before the stop are made once.
 # SIGNAL KILL: killed with SIGKILL (every rank at once, as a lost node) once a random
 # checkpoint (step 300-1500) is written; the resumed run continues from the newest complete
 # checkpoint. Same ranks: bit-identical particle tables and time steps; other ranks: equal
@@ -23,14 +25,14 @@
 # CELLS (Grid/Cells per deal.II cell, default 1): the resumed run builds deal.II cells of that many
 # MPM cells again and inserts the saved points into them.
 set -eu
-exe=$1 out=$2 np_run=$3 np_resume=$4 signal=$5 backend=${6:-cpu} nodes=${7:-all} precision=${8:-double} cells=${9:-1}
+exe=$1 out=$2 np_run=$3 np_resumes=$4 signal=$5 backend=${6:-cpu} nodes=${7:-all} precision=${8:-double} cells=${9:-1}
 if [ "$backend" = cuda ] && ! nvidia-smi -L >/dev/null 2>&1; then echo "no CUDA device: skipped"; exit 77; fi
 here=$(cd "$(dirname "$0")" && pwd)
 # numpy for compare_np.py: Debian's python3 (CI), else the first on PATH (GPU hosts)
 py=/usr/bin/python3; "$py" -c "import numpy" 2>/dev/null || py=python3
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
 rm -rf "$out" && mkdir -p "$out"
-prm=$out/kill_${np_run}_${np_resume}_${signal}.prm   # a name no other test's processes carry
+prm=$out/kill_${np_run}_${np_resumes//,/-}_${signal}.prm   # a name no other test's processes carry
 end_time=0.3; [ "$backend" = cuda ] && end_time=2 # a GPU runs the 0.3 s in well under a second
 sed -e "s/set End time *= .*/set End time = $end_time/" \
     -e 's|set Directory *= output-collapse-small-2d|set Directory = OUT\n  set Write particle table = true|' \
@@ -76,32 +78,47 @@ if grep -q "dealii-mpm: done" "$out/stopped.log"; then
 fi
 echo "stopped with SIG$signal at step $last or later (threshold $threshold)"
 
-# Resumed from the newest complete checkpoint.
-launch "$np_resume" "$out/stopped.prm" --resume "$out/stopped/checkpoints" > "$out/resumed.log" 2>&1 ||
-  { echo "FAILED: the resumed run failed"; tail -20 "$out/resumed.log"; exit 1; }
-grep "resumed from" "$out/resumed.log"
-if [ "$signal" = KILL ] && [ "$np_run" = "$np_resume" ] && [ "$backend" = cpu ]; then
-  final=$(ls "$out/whole" | sed -n 's/^particle_table_\([0-9]*\)\..*/\1/p' | sort -n | tail -1)
-  for f in "$out/whole"/particle_table_"$final".*.csv; do
-    cmp "$f" "$out/stopped/$(basename "$f")" || { echo "FAILED: $(basename "$f") differs from the run left alone"; exit 1; }
-  done
-  # Every column: the same steps, and the same sums (the threaded reductions are deterministic).
-  cmp "$out/whole/history.csv" "$out/stopped/history.csv" || { echo "FAILED: history.csv differs"; exit 1; }
-  echo "ok: final particle tables and history bit-identical to the run left alone"
-elif [ "$backend" = cuda ] && [ "$precision" = float ]; then
-  # The bound: the run left alone against the same scene in double, to 0.3 s, same ranks.
-  sed -e "s|= OUT|= $out/double|" -e "s/set End time = .*/set End time = 0.3/" \
-      -e "s/set Precision = float/set Precision = double/" "$prm" > "$out/double.prm"
-  launch "$np_run" "$out/double.prm" > "$out/double.log" 2>&1 ||
-    { echo "FAILED: the double run failed"; tail -20 "$out/double.log"; exit 1; }
-  grep -Eq "backend cuda in float" "$out/whole.log" || { echo "FAILED: the run left alone was not in float"; exit 1; }
-  "$py" "$here/compare_np.py" "$out/whole" "$out/stopped" --time 0.3 --spread "$out/double" \
-    --spread-factor 1 --rtol 0
-elif [ "$backend" = cuda ]; then
-  # At 0.3 s, over 1,000 steps after the checkpoint: the 2 s run settles the heap through
-  # thousands of frictional contacts more, which amplify round-off as any two GPU runs
-  # (whose atomic sums have no fixed order) differ by the end (doc/checkpoints.md).
-  "$py" "$here/compare_np.py" "$out/whole" "$out/stopped" --rtol 1e-10 --time 0.3
-else
-  "$py" "$here/compare_np.py" "$out/whole" "$out/stopped" --rtol 1e-10
-fi
+# Resumed from the newest complete checkpoint, on each of the NP_RESUME rank counts: the stopped
+# run's folder is copied first, so that every resumed run starts from the same checkpoint.
+resume_and_compare() { # NP DIR: resume a copy of the stopped run in DIR on NP ranks, compare
+  local np_resume=$1 dir=$2
+  [ "$dir" = "$out/stopped" ] || cp -a "$out/stopped.copy" "$dir"
+  sed "s|= OUT|= $dir|" "$prm" > "$dir.prm"
+  launch "$np_resume" "$dir.prm" --resume "$dir/checkpoints" > "$dir.resumed.log" 2>&1 ||
+    { echo "FAILED: the run resumed on $np_resume rank(s) failed"; tail -20 "$dir.resumed.log"; exit 1; }
+  grep "resumed from" "$dir.resumed.log"
+  if [ "$signal" = KILL ] && [ "$np_run" = "$np_resume" ] && [ "$backend" = cpu ]; then
+    final=$(ls "$out/whole" | sed -n 's/^particle_table_\([0-9]*\)\..*/\1/p' | sort -n | tail -1)
+    for f in "$out/whole"/particle_table_"$final".*.csv; do
+      cmp "$f" "$dir/$(basename "$f")" || { echo "FAILED: $(basename "$f") differs from the run left alone"; exit 1; }
+    done
+    # Every column: the same steps, and the same sums (the threaded reductions are deterministic).
+    cmp "$out/whole/history.csv" "$dir/history.csv" || { echo "FAILED: history.csv differs"; exit 1; }
+    echo "ok: resumed on $np_resume rank(s): final particle tables and history bit-identical to the run left alone"
+  elif [ "$backend" = cuda ] && [ "$precision" = float ]; then
+    # The bound: the run left alone against the same scene in double, to 0.3 s, same ranks.
+    if [ ! -d "$out/double" ]; then
+      sed -e "s|= OUT|= $out/double|" -e "s/set End time = .*/set End time = 0.3/" \
+          -e "s/set Precision = float/set Precision = double/" "$prm" > "$out/double.prm"
+      launch "$np_run" "$out/double.prm" > "$out/double.log" 2>&1 ||
+        { echo "FAILED: the double run failed"; tail -20 "$out/double.log"; exit 1; }
+    fi
+    grep -Eq "backend cuda in float" "$out/whole.log" || { echo "FAILED: the run left alone was not in float"; exit 1; }
+    "$py" "$here/compare_np.py" "$out/whole" "$dir" --time 0.3 --spread "$out/double" \
+      --spread-factor 1 --rtol 0
+  elif [ "$backend" = cuda ]; then
+    # At 0.3 s, over 1,000 steps after the checkpoint: the 2 s run settles the heap through
+    # thousands of frictional contacts more, which amplify round-off as any two GPU runs
+    # (whose atomic sums have no fixed order) differ by the end (doc/checkpoints.md).
+    "$py" "$here/compare_np.py" "$out/whole" "$dir" --rtol 1e-10 --time 0.3
+  else
+    "$py" "$here/compare_np.py" "$out/whole" "$dir" --rtol 1e-10
+  fi
+}
+resume_counts=$(echo "$np_resumes" | tr ',' ' ')
+[ "$(echo $resume_counts | wc -w)" -gt 1 ] && cp -a "$out/stopped" "$out/stopped.copy"
+first=1
+for n in $resume_counts; do
+  if [ $first = 1 ]; then resume_and_compare "$n" "$out/stopped"; first=0
+  else resume_and_compare "$n" "$out/stopped-np$n"; fi
+done
