@@ -21,6 +21,9 @@
 //                           default 20), so that the warp adders reduce runs of shared nodes
 //   --shape gimp|linear|bspline2|bspline3|cpdi   the shape function (default gimp)
 //   --domain detF|Fii|U|none                GIMP's domain update (default detF, P1's own)
+//   --launch-modes N        after the timed run, N steps at a fixed time step three ways: the
+//                           reduction read back after every step (as the programs run), never
+//                           read back (the host runs ahead), and each step one CUDA graph
 #include "p1_scene.h"
 
 #include <mpm/core/backend/cuda_backend.h>
@@ -61,7 +64,80 @@ namespace
     AffineMatrix     affine_matrix = AffineMatrix::velocity_gradient;
     bool             hencky   = false;
     bool             all_physics() const { return affine || hencky; }
+    long             launch_mode_steps = 0;
   };
+
+  // What the host's round trip per step and the launches themselves cost: N steps at a fixed
+  // time step (a measurement, not a run: the gravity and the time step stay as they are)
+  // (1) reading the step's reduction back as the programs do, (2) not reading it back, so
+  // that the host queues launches ahead of the device, (3) each step one CUDA graph,
+  // captured again after each sort (the sort swaps the point arrays the kernels hold).
+  template <typename StepF, typename SortF>
+  void time_launch_modes(CudaBackend &backend, StepF &&step, SortF &&sort_if_due, const double dt, const long n_steps,
+                         const int n_points)
+  {
+    const cudaStream_t stream = backend.get_stream();
+    auto timed = [&](auto &&body) {
+      backend.synchronize();
+      const auto t0 = std::chrono::steady_clock::now();
+      body();
+      backend.synchronize();
+      return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() * 1e3 / n_steps;
+    };
+    const double read_back_ms = timed([&] {
+      for (long i = 0; i < n_steps; ++i)
+        {
+          sort_if_due(i);
+          step(dt);
+        }
+    });
+    backend.keep_reductions_on_device = true;
+    const double ahead_ms = timed([&] {
+      for (long i = 0; i < n_steps; ++i)
+        {
+          sort_if_due(i);
+          step(dt);
+        }
+    });
+    cudaGraphExec_t exec     = nullptr;
+    int             captures = 0;
+    auto            capture  = [&] {
+      cudaGraph_t graph;
+      MPM_CUDA_CHECK(cudaStreamBeginCapture(stream, cudaStreamCaptureModeThreadLocal));
+      step(dt);
+      MPM_CUDA_CHECK(cudaStreamEndCapture(stream, &graph));
+      if (exec != nullptr)
+        MPM_CUDA_CHECK(cudaGraphExecDestroy(exec));
+      MPM_CUDA_CHECK(cudaGraphInstantiate(&exec, graph, 0));
+      MPM_CUDA_CHECK(cudaGraphDestroy(graph));
+      ++captures;
+    };
+    const double graph_ms = timed([&] {
+      for (long i = 0; i < n_steps; ++i)
+        {
+          if (sort_if_due(i) || exec == nullptr)
+            capture();
+          MPM_CUDA_CHECK(cudaGraphLaunch(exec, stream));
+        }
+    });
+    backend.keep_reductions_on_device = false;
+    if (exec != nullptr)
+      MPM_CUDA_CHECK(cudaGraphExecDestroy(exec));
+    // The kernels alone: the same step's launches timed with events, 5 steps.
+    backend.enable_kernel_timing(true);
+    double kernels_ms = 0;
+    for (int i = 0; i < 5; ++i)
+      {
+        step(dt);
+        for (const float t : backend.kernel_times_ms())
+          kernels_ms += t / 5;
+      }
+    backend.enable_kernel_timing(false);
+    std::printf("  launch modes, %d points, %ld steps each, ms per step: read back every step %.4f, host ahead "
+                "%.4f, one graph per step %.4f (%d captures); the launches' own times sum to %.4f\n",
+                n_points, n_steps, read_back_ms, ahead_ms, graph_ms, captures, kernels_ms);
+    std::fflush(stdout);
+  }
 
   // Reorder every point array by perm (new point i is old point perm[i]).
   template <typename Real>
@@ -208,23 +284,27 @@ namespace
     dmaterials.upload(materials);
     const double setup_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
-    CudaBackend backend;
+    // A stream of its own where a step is captured into a graph (the legacy stream cannot be).
+    cudaStream_t own_stream = nullptr;
+    if (opt.launch_mode_steps > 0)
+      MPM_CUDA_CHECK(cudaStreamCreateWithFlags(&own_stream, cudaStreamNonBlocking));
+    CudaBackend backend(own_stream);
     backend.block_size = opt.block;
     PointOrder<3, Real> order;
     auto        gv = dgrid.view();
     auto        pv = dpoints.view();
     // Sorting swaps the point arrays: the view is taken again after each sort.
     auto sort_if_due = [&](const long step) {
-      if (opt.sort_every > 0 && step % opt.sort_every == 0)
-        {
-          if (opt.shape == ShapeFunction::linear || opt.shape == ShapeFunction::cpdi) // CPDI: by the point's cell
-            order.template sort<LinearShape>(backend, gv, dpoints);
-          else if (opt.shape == ShapeFunction::bspline3)
-            order.template sort<CubicBSplineShape>(backend, gv, dpoints);
-          else // GIMP and the quadratic B-spline share the stencil's first node
-            order.template sort<GimpShape>(backend, gv, dpoints);
-          pv = dpoints.view();
-        }
+      if (!(opt.sort_every > 0 && step % opt.sort_every == 0))
+        return false;
+      if (opt.shape == ShapeFunction::linear || opt.shape == ShapeFunction::cpdi) // CPDI: by the point's cell
+        order.template sort<LinearShape>(backend, gv, dpoints);
+      else if (opt.shape == ShapeFunction::bspline3)
+        order.template sort<CubicBSplineShape>(backend, gv, dpoints);
+      else // GIMP and the quadratic B-spline share the stencil's first node
+        order.template sort<GimpShape>(backend, gv, dpoints);
+      pv = dpoints.view();
+      return true;
     };
     StepSettings<3, Real> s = mpm_bench::p1_settings<Real>();
     s.domain_update         = opt.shape == ShapeFunction::gimp ? opt.domain : DomainUpdate::none;
@@ -373,6 +453,12 @@ namespace
             std::fprintf(table, "\n");
           }
       }
+    if (opt.launch_mode_steps > 0)
+      {
+        time_launch_modes(backend, step, sort_if_due, P1::cfl * P1::h / (c + max_speed), opt.launch_mode_steps,
+                          n_points);
+        MPM_CUDA_CHECK(cudaStreamDestroy(own_stream));
+      }
     return true;
   }
 } // namespace
@@ -448,6 +534,8 @@ int main(int argc, char **argv)
             }
           opt.hencky = m == "hencky";
         }
+      else if (a == "--launch-modes" && i + 1 < argc)
+        opt.launch_mode_steps = std::atol(argv[++i]);
       else if (a == "--block" && i + 1 < argc)
         opt.block = std::atoi(argv[++i]);
       else if (a == "--table" && i + 1 < argc)
@@ -469,7 +557,7 @@ int main(int argc, char **argv)
           std::printf("usage: %s [--fp32] [--sizes 20,160,640,2560] [--steps N] [--profile] [--table FILE]\n"
                       "          [--order generated|cell|random] [--block N] [--material dp|elastic] [--sort-every N]\n"
                       "          [--shape gimp|linear|bspline2|bspline3|cpdi] [--domain detF|Fii|U|none]\n"
-                      "          [--transfer tpic|apic] [--law jaumann|hencky]\n",
+                      "          [--transfer tpic|apic] [--law jaumann|hencky] [--launch-modes N]\n",
                       argv[0]);
           return 2;
         }

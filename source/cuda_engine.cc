@@ -312,6 +312,16 @@ namespace mpm
         return device->step(s, dt);
       }
 
+      bool queues_steps() const override { return shared_grid == nullptr; } // one rank
+
+      void queue_step(const StepSettings<dim, double> &s, const TimeStepRule &rule, const double time,
+                      const double next_output, const bool speed_from_host, const double host_speed) override
+      {
+        device->queue_step(s, rule, time, next_output, speed_from_host, host_speed);
+      }
+
+      QueuedStep collect_step() override { return device->collect_step(); }
+
       PointTotals<dim, double> totals() override { return device->totals(); }
 
       double relative_mass_round_off() const override { return relative_mass_round_off_of<Real>(); }

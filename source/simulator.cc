@@ -376,13 +376,8 @@ namespace mpm
     if (s.grid_build.valid() && s.grid_build.wait_for(std::chrono::seconds(0)) == std::future_status::ready)
       s.join_grid();
 
-    const double end = parameters.end_time;
-    double       dt =
-      parameters.adaptive_time_step ? parameters.cfl * s.h / (s.c_el + s.max_speed) : parameters.fixed_time_step;
-    dt = std::min(dt, end - s.time);
-    if (parameters.output_interval > 0)
-      dt = std::min(dt, std::max(s.next_output - s.time, 1e-12 * end)); // land on output times
-    s.dt = dt;
+    const double       end  = parameters.end_time;
+    const TimeStepRule rule = s.time_step_rule(); // CFL, landing on the end and on output times
 
     const double ramp =
       parameters.gravity_ramp_time > 0 ? std::min(1.0, s.time / parameters.gravity_ramp_time) : 1.0;
@@ -390,8 +385,32 @@ namespace mpm
       s.settings.gravity[d] = ramp * parameters.gravity[d];
 
     s.switch_plasticity_on_when_due();
-    s.engine_step(dt);
-    s.work_of_gravity += dt * s.global_sum(s.gravity_power);
+    double dt = 0;
+    if (s.queue_steps())
+      {
+        // This step goes into the GPU's queue behind the last one, whose speed the device
+        // uses for this step's time step; the host collects the last step meanwhile and
+        // computes the same time step from the same speed.
+        const bool speed_from_host = !s.step_in_queue;
+        const auto start           = std::chrono::steady_clock::now();
+        s.timed("MPM step", [&]() {
+          s.engine->queue_step(s.settings, rule, s.time, s.next_output, speed_from_host, s.max_speed);
+        });
+        s.loop_times.engine += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        s.settle();
+        dt                  = next_time_step(rule, s.max_speed, s.time, s.next_output);
+        s.step_in_queue     = true;
+        s.queued_dt         = dt;
+        s.queued_time_after = s.time + dt;
+        s.queued_step_after = s.step + 1;
+      }
+    else
+      {
+        dt = next_time_step(rule, s.max_speed, s.time, s.next_output);
+        s.engine_step(dt);
+        s.work_of_gravity += dt * s.global_sum(s.gravity_power);
+      }
+    s.dt = dt;
     s.time += dt;
     ++s.step;
 
@@ -443,6 +462,7 @@ namespace mpm
     if (s.finished_run)
       return;
     s.finished_run = true;
+    s.settle();    // the last queued step
     s.join_grid(); // a short run may end before the grid thread does
     if (s.stopped)
       {

@@ -7,6 +7,7 @@ namespace mpm
   HostPoints<dim, double> Simulator<dim>::points() const
   {
     AssertThrow(state->set_up, dealii::ExcMessage("Simulator::points() needs setup() first."));
+    state->settle(); // a step queued on the GPU has ended, and passed the checks after it
     PointSnapshot<dim> snapshot;
     state->engine->snapshot(snapshot);
     return std::move(snapshot.points);
@@ -17,6 +18,7 @@ namespace mpm
   {
     State &s = *state;
     AssertThrow(s.set_up, dealii::ExcMessage("Simulator::set_points() needs setup() first."));
+    s.settle();
     PointSnapshot<dim> snapshot;
     s.engine->snapshot(snapshot);
     // What is wrong with this rank's points, if anything; every rank stops when one does

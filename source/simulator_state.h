@@ -4,6 +4,7 @@
 #define MPM_SOURCE_SIMULATOR_STATE_H
 
 #include <mpm/core/migration.h>
+#include <mpm/core/time_step_rule.h>
 #include <mpm/dealii/background_grid.h>
 #include <mpm/dealii/checkpoint.h>
 #include <mpm/dealii/cuda_engine.h>
@@ -331,6 +332,65 @@ namespace mpm
       loop_times.engine += in_engine;
       loop_times.timer_sync += std::chrono::duration<double>(stepped - entered).count() - in_engine;
       ++loop_times.steps;
+      after_step(r, dt, time + dt, step + 1, stepped);
+    }
+
+    // Backend/Queue steps (one rank on the GPU, nodes everywhere): each step is queued on the
+    // device before the last one has ended, and its reductions are collected one step later
+    // (settle()), so that the GPU never waits for the host between steps.
+    bool queue_steps() const
+    {
+      return parameters.queue_steps && !parallel && !equilibrating && engine->queues_steps() &&
+             !engine->follows_material();
+    }
+    // The step queued last and not yet collected: the time step the host's rule gave it, the
+    // time and step count after it.
+    bool   step_in_queue = false;
+    double queued_dt = 0, queued_time_after = 0;
+    long   queued_step_after = 0;
+
+    // The rule of the next time step (the host's and, for queued steps, the device's).
+    TimeStepRule time_step_rule() const
+    {
+      TimeStepRule rule;
+      rule.adaptive         = parameters.adaptive_time_step;
+      rule.cfl_times_h      = parameters.cfl * h;
+      rule.wave_speed       = c_el;
+      rule.fixed_step       = parameters.fixed_time_step;
+      rule.end_time         = parameters.end_time;
+      rule.lands_on_outputs = parameters.output_interval > 0;
+      rule.shortest_landing = 1e-12 * parameters.end_time;
+      return rule;
+    }
+
+    // Collects the queued step: its reductions, the checks after it and the work of gravity,
+    // as engine_step and the loop do for a step that was not queued. Before anything reads
+    // or changes the points, the time history or the totals.
+    void settle()
+    {
+      if (!step_in_queue)
+        return;
+      step_in_queue      = false;
+      const auto       start = std::chrono::steady_clock::now();
+      const QueuedStep q     = timed("MPM step", [&]() { return engine->collect_step(); });
+      // The engine's time of a queued step: its queueing (advance()) and the wait for its end.
+      loop_times.engine += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      ++loop_times.steps;
+      AssertThrow(q.dt == queued_dt,
+                  dealii::ExcMessage("Internal: the GPU took a time step of " + dealii::Utilities::to_string(q.dt) +
+                                     " s where the host's rule gives " + dealii::Utilities::to_string(queued_dt) +
+                                     " s (Backend/Queue steps = false avoids the queue)."));
+      after_step(nan_as_infinite(q.reduction), q.dt, queued_time_after, queued_step_after,
+                 std::chrono::steady_clock::now());
+      work_of_gravity += q.dt * gravity_power;
+    }
+
+    // What every step needs after it (engine_step's list), from its reductions r; dt, and the
+    // time and step count after it, for the messages.
+    void after_step(const StepReduction<double> &r, const double dt, const double time_after, const long step_after,
+                    const std::chrono::steady_clock::time_point stepped)
+    {
+      using clock       = std::chrono::steady_clock;
       gravity_power     = r.gravity_power;
       max_speed         = r.max_speed;
       max_removed_speed = r.max_removed_speed;
@@ -338,7 +398,8 @@ namespace mpm
       const auto when = [&]() {
         return equilibrating ?
                  "in damped step " + std::to_string(equilibration.steps + 1) + " of the equilibration" :
-                 "at t = " + dealii::Utilities::to_string(time + dt) + " s (step " + std::to_string(step + 1) + ")";
+                 "at t = " + dealii::Utilities::to_string(time_after) + " s (step " + std::to_string(step_after) +
+                   ")";
       };
       if (parallel)
         {
@@ -635,6 +696,7 @@ namespace mpm
     // points before, the CPU's scatter slabs): the resumed run is bit-identical to this one.
     std::string write_checkpoint()
     {
+      settle();
       join_grid();
       dealii::TimerOutput::Scope scope(timer, "checkpoint");
       const auto                 started = std::chrono::steady_clock::now();
@@ -799,6 +861,7 @@ namespace mpm
 
     void record_history()
     {
+      settle();
       timed("history", [&]() {
         const auto local  = engine->totals();
         const auto totals = parallel ? global_totals<dim>(local, communicator) : local;
@@ -819,6 +882,7 @@ namespace mpm
     // is brought up to date only where it is needed (re-sorts, repartitions).
     void write_output()
     {
+      settle();
       if (time == 0 && grid_build.valid())
         {
           engine->snapshot(output->next_snapshot());

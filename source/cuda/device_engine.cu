@@ -8,6 +8,7 @@
 #include <mpm/core/exchange_overlap.h>
 #include <mpm/core/migration.h>
 #include <mpm/core/precision.h>
+#include <mpm/core/time_step_rule.h>
 #include <mpm/cuda/device_engine.h>
 
 #include <cub/device/device_select.cuh>
@@ -509,6 +510,67 @@ namespace mpm
       {}
     } // namespace
 
+    // Steps queued behind each other (DeviceEngine::queue_step): each step's time step is
+    // computed on the device from the last step's largest speed, and each step's record (its
+    // reductions and its time step) is copied into one of two pinned host slots that the
+    // host reads when it collects the step, one step behind the device.
+    constexpr int queued_record_values = 4; // max speed, power of gravity, max removed speed, dt
+
+    template <typename Real>
+    struct QueuedSteps
+    {
+      DeviceArray<double> records; // two slots of queued_record_values
+      DeviceArray<Real>   time_step; // the queued step's dt, in the points' precision
+      double             *host = nullptr; // pinned: two slots
+      cudaEvent_t         copied[2] = {nullptr, nullptr};
+      long                queued = 0, collected = 0;
+
+      void allocate()
+      {
+        if (host != nullptr)
+          return;
+        records.resize(2 * queued_record_values);
+        time_step.resize(1);
+        MPM_CUDA_CHECK(cudaMallocHost(&host, 2 * queued_record_values * sizeof(double)));
+        for (cudaEvent_t &e : copied)
+          MPM_CUDA_CHECK(cudaEventCreateWithFlags(&e, cudaEventDisableTiming));
+      }
+
+      ~QueuedSteps()
+      {
+        // No throwing from a destructor: errors here are ignored.
+        for (cudaEvent_t e : copied)
+          if (e != nullptr)
+            cudaEventDestroy(e);
+        if (host != nullptr)
+          cudaFreeHost(host);
+      }
+    };
+
+    // The queued step's time step, from the last step's record (or the host's speed for the
+    // first step queued after one that was not), by the host's rule: the same doubles, the
+    // same operations.
+    template <typename Real>
+    __global__ void queued_time_step_kernel(const TimeStepRule rule, const double time, const double next_output,
+                                            const bool speed_from_host, const double host_speed,
+                                            const double *last_record, double *record, Real *time_step)
+    {
+      const double speed = speed_from_host ? host_speed : finite_or_infinite_speed(last_record[0]);
+      const double dt    = next_time_step(rule, speed, time, next_output);
+      record[3]          = dt;
+      *time_step         = static_cast<Real>(dt);
+    }
+
+    // The step's reductions (left on the device by the backend) into its record, in double
+    // as the host converts them.
+    template <typename Real>
+    __global__ void queued_step_record_kernel(const StepReduction<Real> *reduction, double *record)
+    {
+      record[0] = static_cast<double>(reduction->max_speed);
+      record[1] = static_cast<double>(reduction->gravity_power);
+      record[2] = static_cast<double>(reduction->max_removed_speed);
+    }
+
     template <int dim, typename Real>
     struct DeviceEngine<dim, Real>::Impl
     {
@@ -567,6 +629,7 @@ namespace mpm
       DeviceArray<int>             holding_list, holding_count;
       bool                         cell_sums_at_nodes = false;
       DeviceArray<std::uint8_t>    block_marks; // blocks holding a point's cell (keep_nodes_near_points)
+      QueuedSteps<Real>            queue; // steps queued behind each other (queue_step)
 
       // The device grid's view, with the averaging's cell arrays where they exist.
       GridView<dim, Real> view()
@@ -795,9 +858,74 @@ namespace mpm
     StepReduction<double> DeviceEngine<dim, Real>::step(const StepSettings<dim, double> &settings_in_double,
                                                         const double dt_in_double)
     {
-      const StepSettings<dim, Real> s  = converted<Real>(settings_in_double);
-      const Real                    dt = static_cast<Real>(dt_in_double);
-      GridView<dim, Real>           g  = impl->grid.view();
+      if (impl->queue.queued != impl->queue.collected)
+        throw std::logic_error("DeviceEngine::step: a queued step is not collected yet (collect_step)");
+      return converted<double>(run_step(converted<Real>(settings_in_double), static_cast<Real>(dt_in_double)));
+    }
+
+    template <int dim, typename Real>
+    void DeviceEngine<dim, Real>::queue_step(const StepSettings<dim, double> &settings_in_double,
+                                             const TimeStepRule &rule, const double time, const double next_output,
+                                             const bool speed_from_host, const double host_speed)
+    {
+      QueuedSteps<Real> &q = impl->queue;
+      if (q.queued - q.collected >= 2)
+        throw std::logic_error("DeviceEngine::queue_step: two queued steps are not collected yet (collect_step)");
+      if (!speed_from_host && q.queued == 0)
+        throw std::logic_error("DeviceEngine::queue_step: the first queued step needs the host's speed");
+      q.allocate();
+      const int          slot   = static_cast<int>(q.queued % 2);
+      double            *record = q.records.data() + slot * queued_record_values;
+      const double      *last   = q.records.data() + (1 - slot) * queued_record_values;
+      const cudaStream_t stream = impl->backend.get_stream();
+      queued_time_step_kernel<Real><<<1, 1, 0, stream>>>(rule, time, next_output, speed_from_host, host_speed, last,
+                                                         record, q.time_step.data());
+      MPM_CUDA_CHECK_LAUNCH();
+      StepSettings<dim, Real> s = converted<Real>(settings_in_double);
+      s.time_step_on_device     = q.time_step.data();
+      impl->backend.keep_reductions_on_device = true;
+      try
+        {
+          run_step(s, Real(0)); // the kernels read the device's time step
+        }
+      catch (...)
+        {
+          impl->backend.keep_reductions_on_device = false;
+          throw;
+        }
+      impl->backend.keep_reductions_on_device = false;
+      queued_step_record_kernel<Real><<<1, 1, 0, stream>>>(
+        static_cast<const StepReduction<Real> *>(impl->backend.last_reduction_on_device()), record);
+      MPM_CUDA_CHECK_LAUNCH();
+      MPM_CUDA_CHECK(cudaMemcpyAsync(q.host + slot * queued_record_values, record,
+                                     queued_record_values * sizeof(double), cudaMemcpyDeviceToHost, stream));
+      MPM_CUDA_CHECK(cudaEventRecord(q.copied[slot], stream));
+      ++q.queued;
+    }
+
+    template <int dim, typename Real>
+    QueuedStep DeviceEngine<dim, Real>::collect_step()
+    {
+      QueuedSteps<Real> &q = impl->queue;
+      if (q.collected == q.queued)
+        throw std::logic_error("DeviceEngine::collect_step: no step is queued");
+      const int slot = static_cast<int>(q.collected % 2);
+      MPM_CUDA_CHECK(cudaEventSynchronize(q.copied[slot]));
+      const double *record = q.host + slot * queued_record_values;
+      ++q.collected;
+      return QueuedStep{{record[0], record[1], record[2]}, record[3]};
+    }
+
+    template <int dim, typename Real>
+    long DeviceEngine<dim, Real>::queued_steps() const
+    {
+      return impl->queue.queued - impl->queue.collected;
+    }
+
+    template <int dim, typename Real>
+    StepReduction<Real> DeviceEngine<dim, Real>::run_step(const StepSettings<dim, Real> &s, const Real dt)
+    {
+      GridView<dim, Real> g = impl->grid.view();
       if (sort_interval > 0 && impl->steps_since_upload % sort_interval == 0)
         {
           // The overlap's split needs every point's home cell.
@@ -867,7 +995,7 @@ namespace mpm
               impl->backend.enable_kernel_timing(false);
             }
         }
-      return converted<double>(r);
+      return r;
     }
 
     template <int dim, typename Real>

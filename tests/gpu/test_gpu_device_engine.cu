@@ -13,6 +13,13 @@
 //   - CPDI2q in 2D (its corners in state variables, which the engine uploads, sorts with the
 //     points and downloads): a spinning elastic block, 150 steps, points and corners against the
 //     CPU within 1e-10;
+//   - steps queued behind each other (queue_step / collect_step, Backend/Queue steps): the
+//     same P1 steps with the adaptive time step landing on output times and on the end
+//     time, one engine stepped as before (the host's time step from each step's speed), one
+//     queued (the device's time step from the last step's speed, collected one step
+//     behind): each queued step's time step equals the host's rule on the collected speeds
+//     to the bit, the steps and their time steps match the stepped engine's (1e-12), and
+//     the points within 1e-10 as above; a third queued step before a collect is refused;
 //   - the float engine (DeviceEngine<3, float>, Backend/Precision = float) on the same P1 steps:
 //     against the CPU's float step within 1e-5 h in position and 1e-4 of max |v| (float's
 //     round-off, 6e-8, summed in another order), against the double engine within 1e-4 h and
@@ -89,6 +96,107 @@ void cpdi2q_through_engine()
   check(q_max > 1e-3, "CPDI2q: the corners have moved off their rectangles");
   check_below(dx, 1e-10, "CPDI2q: positions, DeviceEngine vs CPU (x/h)");
   check_below(dq, 1e-10, "CPDI2q: corners, DeviceEngine vs CPU (/h)");
+}
+
+// Queued steps against stepped ones (the header's list).
+void queued_steps(HostGrid<3, double> grid, const HostPoints<3, double> &points,
+                  const std::vector<MaterialParameters<double>> &materials, StepSettings<3, double> s)
+{
+  const double dt0 = mpm_bench::P1::cfl * mpm_bench::P1::h / mpm_bench::p1_wave_speed();
+  TimeStepRule rule;
+  rule.cfl_times_h      = mpm_bench::P1::cfl * mpm_bench::P1::h;
+  rule.wave_speed       = mpm_bench::p1_wave_speed();
+  rule.end_time         = 40.3 * dt0;
+  rule.lands_on_outputs = true;
+  rule.shortest_landing = 1e-12 * rule.end_time;
+  const double interval = 2.5 * dt0; // a landing every two or three steps
+  auto next_output_after = [&](const double time, double next_output) {
+    while (time >= next_output * (1 - 1e-12))
+      next_output += interval;
+    return next_output;
+  };
+
+  mpm::cuda::DeviceEngine<3> stepped(grid.view(), materials, ShapeFunction::gimp);
+  stepped.upload_points(points);
+
+  std::vector<double> stepped_dt, queued_dt;
+  {
+    double time = 0, next_output = interval, speed = 0;
+    while (time < rule.end_time * (1 - 1e-12))
+      {
+        const double dt = next_time_step(rule, speed, time, next_output);
+        mpm_bench::p1_gravity(s, time);
+        speed = finite_or_infinite_speed(stepped.step(s, dt).max_speed);
+        stepped_dt.push_back(dt);
+        time += dt;
+        next_output = next_output_after(time, next_output);
+      }
+  }
+  mpm::cuda::DeviceEngine<3> queued(grid.view(), materials, ShapeFunction::gimp);
+  queued.upload_points(points);
+  int    mismatched = 0;
+  double time = 0, next_output = interval, speed = 0, last_dt = 0;
+  int landings = 0;
+  while (time < rule.end_time * (1 - 1e-12))
+    {
+      mpm_bench::p1_gravity(s, time);
+      queued.queue_step(s, rule, time, next_output, queued_dt.empty(), speed);
+      if (!queued_dt.empty())
+        {
+          const QueuedStep q = queued.collect_step();
+          mismatched += q.dt != last_dt;
+          speed = finite_or_infinite_speed(q.reduction.max_speed);
+        }
+      last_dt = next_time_step(rule, speed, time, next_output);
+      landings += last_dt < 0.99 * rule.cfl_times_h / (rule.wave_speed + speed);
+      queued_dt.push_back(last_dt);
+      time += last_dt;
+      next_output = next_output_after(time, next_output);
+    }
+  mismatched += queued.collect_step().dt != last_dt;
+  check(queued.queued_steps() == 0, "every queued step collected");
+
+  double ddt = 0;
+  for (size_t k = 0; k < std::min(stepped_dt.size(), queued_dt.size()); ++k)
+    ddt = std::max(ddt, std::abs(queued_dt[k] - stepped_dt[k]) / dt0);
+  HostPoints<3, double> a, b;
+  stepped.download_points(a);
+  queued.download_points(b);
+  double dx = 0, dv = 0, v_max = 0;
+  for (int i = 0; i < points.size(); ++i)
+    for (int d = 0; d < 3; ++d)
+      {
+        dx    = std::max(dx, std::abs(a.position[d][i] - b.position[d][i]) / mpm_bench::P1::h);
+        dv    = std::max(dv, std::abs(a.velocity[d][i] - b.velocity[d][i]));
+        v_max = std::max(v_max, std::abs(a.velocity[d][i]));
+      }
+  std::printf("test_gpu_device_engine: queued steps, %zu steps (stepped: %zu), %d cut to land on an output or the "
+              "end | device's dt against the host's rule: %d differ | dt against the stepped engine's %.1e dt0 | "
+              "points against it: x/h %.1e, v %.1e (max |v| %.2e)\n",
+              queued_dt.size(), stepped_dt.size(), landings, mismatched, ddt, dx, dv / v_max, v_max);
+  check(landings >= 10, "queued: steps cut to land on output times");
+  check(mismatched == 0, "queued: the device's time step equals the host's rule to the bit");
+  check(queued_dt.size() == stepped_dt.size(), "queued: as many steps as stepped");
+  check_below(ddt, 1e-12, "queued: time steps against the stepped engine's (of dt0)");
+  check(v_max > 1e-4, "queued: the points move");
+  check_below(dx, 1e-10, "queued: positions against the stepped engine (x/h)");
+  check_below(dv / v_max, 1e-10, "queued: velocities against the stepped engine (of max |v|)");
+
+  // A third queued step before a collect is refused (the host's two pinned slots).
+  bool refused = false;
+  queued.queue_step(s, rule, 0, interval, true, 0);
+  queued.queue_step(s, rule, 0, interval, false, 0);
+  try
+    {
+      queued.queue_step(s, rule, 0, interval, false, 0);
+    }
+  catch (const std::logic_error &)
+    {
+      refused = true;
+    }
+  queued.collect_step();
+  queued.collect_step();
+  check(refused, "queue_step refuses a third uncollected step");
 }
 
 // The float engine on P1's steps, against the CPU's float step and the double engine.
@@ -226,6 +334,7 @@ int main()
   check_below(std::abs(m_sum - m_points) / m_points, 1e-12, "downloaded nodal mass sums to the points' mass");
 
   s.gravity[0] = s.gravity[1] = s.gravity[2] = 0; // p1_gravity sets them again from the start
+  queued_steps(grid, points, materials, s);
   float_engine(grid, points, materials, s, dt, n_steps);
   return finish("test_gpu_device_engine");
 }

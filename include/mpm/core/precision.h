@@ -60,7 +60,7 @@ namespace mpm
   template <typename To, int dim, typename From>
   StepSettings<dim, To> converted(const StepSettings<dim, From> &s)
   {
-    static_assert(sizeof(StepSettings<3, double>) == 104, "a field of StepSettings is not copied here");
+    static_assert(sizeof(StepSettings<3, double>) == 112, "a field of StepSettings is not copied here");
     StepSettings<dim, To> r;
     r.scheme = s.scheme;
     for (int d = 0; d < dim; ++d)
@@ -81,6 +81,7 @@ namespace mpm
     r.body_force_state_variable = s.body_force_state_variable;
     r.corner_state_variable     = s.corner_state_variable;
     r.wall_faces                = s.wall_faces;
+    r.time_step_on_device       = nullptr; // a device's own, in its own precision (step.h)
     return r;
   }
 

@@ -121,7 +121,18 @@ namespace mpm
     // friction), where a point's centre stops instead of leaving the grid (stop_at_walls, wall_friction.h).
     // 0: every face is open, as the prm's default `free`.
     std::uint8_t wall_faces = 0;
+    // Where a step is queued on the device before the last one's speeds are back on the host
+    // (time_step_rule.h), its time step is read from here on the device instead of the dt
+    // argument. nullptr: the argument. Not converted between precisions (converted<>()).
+    const Real *time_step_on_device = nullptr;
   };
+
+  // The time step a step's kernels use: the argument, or the device's own (above).
+  template <int dim, typename Real>
+  MPM_HOST_DEVICE inline Real time_step_of(const StepSettings<dim, Real> &s, const Real dt)
+  {
+    return s.time_step_on_device != nullptr ? *s.time_step_on_device : dt;
+  }
 
   // Per-step reductions over the points: the next time step needs the largest speed,
   // the time history the power of gravity.
@@ -621,7 +632,7 @@ namespace mpm
     // so that G2P gathers one nodal vector instead of two (updated_point_velocity).
     template <int dim, typename Real, typename Backend>
     void update_grid(Backend &backend, const GridView<dim, Real> &g, const StepSettings<dim, Real> &s,
-                     const Real dt, const bool zero_momentum = false, const bool zero_cells = false)
+                     const Real dt_given, const bool zero_momentum = false, const bool zero_cells = false)
     {
       // zero_cells: also the pressure averaging's cell sums, which this step's P2G has
       // just applied (explicit_step's deferred averaging), in the same launch.
@@ -629,7 +640,8 @@ namespace mpm
       backend.for_each_node(g.n_nodes > n_cells ? g.n_nodes : n_cells, [=] MPM_HOST_DEVICE(const int n) {
         if (!zero_cell_sums_then_is_node(g, n, n_cells))
           return;
-        const Real m = g.mass[n];
+        const Real dt = time_step_of(s, dt_given);
+        const Real m  = g.mass[n];
         // The force-norm form sees the whole force, the components a boundary holds fixed
         // included (read only for that form: the default reads nothing more).
         Real norm = Real(0);
@@ -877,7 +889,7 @@ namespace mpm
     void grid_to_particle_kinematics(Backend &backend, const GridView<dim, Real> &g,
                                      const PointsView<dim, Real> &p,
                                      const MaterialParameters<Real> *materials,
-                                     const StepSettings<dim, Real> &s, const Real dt,
+                                     const StepSettings<dim, Real> &s, const Real dt_given,
                                      const bool move_points, const bool deform_points,
                                      const void *stencils = nullptr, const bool scatter_pressure = false)
     {
@@ -890,6 +902,7 @@ namespace mpm
       backend.gather_points(p.n_points, [=] MPM_HOST_DEVICE(const int i) {
         if (p.material[i] < 0)
           return;
+        const Real dt = time_step_of(s, dt_given);
         Real x[dim], lp[domain_values<dim, Shape>()], dx[dim] = {};
         Mat3<Real> L = Mat3<Real>::zero(); // velocity gradient; plane strain keeps row/column z zero
         for (int d = 0; d < dim; ++d)

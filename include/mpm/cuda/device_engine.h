@@ -16,6 +16,7 @@
 #include <mpm/core/material/material.h>
 #include <mpm/core/shape_functions.h>
 #include <mpm/core/step.h>
+#include <mpm/core/time_step_rule.h>
 #include <mpm/core/views.h>
 
 #include <cstdint>
@@ -109,6 +110,17 @@ namespace mpm
       // matrices) and a material with Hencky's law run the step's second variant of kernels
       // (DevicePhysics::all, step.h); everything else the standard one.
       StepReduction<double> step(const StepSettings<dim, double> &settings, double dt);
+
+      // A step queued behind the last one without waiting for it: its time step is computed
+      // on the device by rule (time_step_rule.h) from the last queued step's largest speed
+      // or, with speed_from_host, from host_speed (the first step queued after a step()
+      // or a load). time and next_output are the step's start and the next output time.
+      // At most two queued steps may be uncollected; step() needs none.
+      void queue_step(const StepSettings<dim, double> &settings, const TimeStepRule &rule, double time,
+                      double next_output, bool speed_from_host, double host_speed);
+      // The oldest uncollected queued step's reductions and time step (waits for its end).
+      QueuedStep collect_step();
+      long       queued_steps() const; // queued and not yet collected
       PointTotals<dim, double> totals();
       void set_materials(const std::vector<MaterialParameters<double>> &materials);
 
@@ -170,6 +182,10 @@ namespace mpm
       struct Impl;
       std::unique_ptr<Impl> impl;
       int                   sort_interval = 20;
+
+      // One step with settings in the device's precision (their time_step_on_device, if set,
+      // instead of dt); the reduction as the backend returned it.
+      StepReduction<Real> run_step(const StepSettings<dim, Real> &settings, Real dt);
     };
   } // namespace cuda
 } // namespace mpm

@@ -13,6 +13,7 @@
 #include <mpm/core/active_nodes.h>
 #include <mpm/core/diagnostics.h>
 #include <mpm/core/step.h>
+#include <mpm/core/time_step_rule.h>
 #include <mpm/dealii/material_points.h>
 #include <mpm/dealii/output_writer.h>
 
@@ -79,6 +80,24 @@ namespace mpm
     // the next re-sort).
     virtual long n_points() const = 0;
     virtual StepReduction<double>   step(const StepSettings<dim, double> &s, double dt) = 0;
+    // One rank on the GPU (Backend/Queue steps): a step queued behind the last one without
+    // waiting for it, its time step computed on the device by the host's rule
+    // (time_step_rule.h) from the last queued step's largest speed, or with speed_from_host
+    // from host_speed (the first step queued after anything else). collect_step() waits for
+    // the oldest queued step and returns its reductions and time step; at most two may be
+    // uncollected, and every one must be collected before anything else reads or changes
+    // the points.
+    virtual bool queues_steps() const { return false; }
+    virtual void queue_step(const StepSettings<dim, double> & /*s*/, const TimeStepRule & /*rule*/, double /*time*/,
+                            double /*next_output*/, bool /*speed_from_host*/, double /*host_speed*/)
+    {
+      AssertThrow(false, dealii::ExcMessage("Internal: this engine does not queue steps."));
+    }
+    virtual QueuedStep collect_step()
+    {
+      AssertThrow(false, dealii::ExcMessage("Internal: this engine does not queue steps."));
+      return {};
+    }
     virtual PointTotals<dim, double> totals()                                         = 0;
     // For output: copies the points as they are now into snapshot.points (engine order,
     // points that left the grid included with material < 0) and sets snapshot.labels.

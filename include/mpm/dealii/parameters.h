@@ -147,6 +147,7 @@ namespace mpm
     // Backend
     std::string backend;
     int         sort_interval = 20; // cuda: steps between re-sorts of the points on the device
+    bool        queue_steps   = true; // cuda, one rank: steps queued before the last one ends
     bool        single_precision = false; // Backend/Precision = float: points, nodes and step in float
 
     // The state variables every point of the run carries (user_model.h): their names, the

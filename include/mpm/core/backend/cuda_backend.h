@@ -507,6 +507,17 @@ namespace mpm
       launch(n, std::forward<F>(f));
     }
 
+    // true: reduce_points leaves its result on the device (last_reduction_on_device) and
+    // returns the identity without waiting for the device, so that the host can queue the
+    // next launches at once (a step queued behind the last one, DeviceEngine::queue_step).
+    bool keep_reductions_on_device = false;
+
+    // Where the last reduction's result is on the device, until the next reduction.
+    const void *last_reduction_on_device() const
+    {
+      return static_cast<const unsigned char *>(scratch) + max_reduce_blocks * max_reduction_bytes;
+    }
+
     // Reduction on the device; returns the value on the host (synchronises the stream).
     template <typename T, typename F, typename Combine>
     T reduce_points(const int n, const T identity, F &&f, Combine &&combine)
@@ -530,6 +541,8 @@ namespace mpm
         <<<1, reduce_threads, reduce_threads * sizeof(T), stream>>>(blocks, identity, combine, partials, result);
       MPM_CUDA_CHECK_LAUNCH();
       end_timing();
+      if (keep_reductions_on_device)
+        return identity;
       MPM_CUDA_CHECK(cudaMemcpyAsync(host_result, result, sizeof(T), cudaMemcpyDeviceToHost, stream));
       MPM_CUDA_CHECK(cudaStreamSynchronize(stream));
       T value;
