@@ -547,10 +547,10 @@ namespace mpm
                       "cuda on one MPI rank: queue each step on the GPU before the last one has ended, its time "
                       "step computed on the device from the last step's largest speed by the same rule as the "
                       "host's, so that the GPU does not wait for the host between steps (the same steps and time "
-                      "steps, checked to the bit). Saves what lies between the steps: 4% of P2's step, a quarter "
-                      "of a 10,000-point scene's (doc/performance.md). false: the host waits for each step's "
-                      "speed before it starts the next. Not with Grid/Nodes = near material, whose check after "
-                      "each step needs the points where they are.");
+                      "steps, checked to the bit), and the steps between two re-sorts launched as one CUDA graph "
+                      "each. On an H200 P2's step 2% shorter, V3 2D's 14% (doc/performance.md). false: the host "
+                      "waits for each step's speed before it starts the next. Not with Grid/Nodes = near "
+                      "material, whose check after each step needs the points where they are.");
     prm.declare_entry("Precision", "double", Patterns::Selection("double|float"),
                       "The floating-point type of the points, the nodes and the step: double, or float (the engine's "
                       "point and node arrays in half the bytes; with Backend = cuda P2's step 1.46x faster, on the CPU "

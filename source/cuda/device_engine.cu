@@ -571,10 +571,71 @@ namespace mpm
       record[2] = static_cast<double>(reduction->max_removed_speed);
     }
 
+    // The engine's stream: created (a blocking stream, so that it stays ordered with the
+    // legacy stream's copies as before), because a step can be captured into a CUDA graph on
+    // a stream of its own only.
+    struct OwnStream
+    {
+      cudaStream_t stream = nullptr;
+      OwnStream() { MPM_CUDA_CHECK(cudaStreamCreate(&stream)); }
+      ~OwnStream() { cudaStreamDestroy(stream); } // no throwing from a destructor
+      OwnStream(const OwnStream &)            = delete;
+      OwnStream &operator=(const OwnStream &) = delete;
+    };
+
+    // Queued steps whose launches are those of an earlier one (the same settings, arrays and
+    // sizes; only the values in device memory differ) replay that step's launches as one CUDA
+    // graph: one launch on the host instead of a dozen. A graph per key of the step's launch
+    // arguments, the two latest (the re-sort swaps the point arrays between two buffers).
+    struct StepGraphs
+    {
+      struct Entry
+      {
+        std::vector<unsigned char> key;
+        cudaGraphExec_t            exec          = nullptr;
+        bool                       pending_after = false; // the host's averaging flag after the step
+        long                       last_used     = 0;
+      };
+      Entry                      entries[2];
+      std::vector<unsigned char> last_direct_key; // the last step run without a graph
+      long                       captures = 0, replays = 0, uses = 0;
+      bool                       enabled  = true; // MPM_CUDA_GRAPHS=0: off
+
+      Entry *find(const std::vector<unsigned char> &key)
+      {
+        for (Entry &e : entries)
+          if (e.exec != nullptr && e.key == key)
+            return &e;
+        return nullptr;
+      }
+      Entry &oldest() { return entries[0].last_used <= entries[1].last_used ? entries[0] : entries[1]; }
+      void   clear()
+      {
+        for (Entry &e : entries)
+          {
+            if (e.exec != nullptr)
+              cudaGraphExecDestroy(e.exec);
+            e = Entry();
+          }
+        last_direct_key.clear();
+      }
+      ~StepGraphs() { clear(); }
+    };
+
+    // Appends the bytes of a value to a key.
+    template <typename T>
+    void append_key(std::vector<unsigned char> &key, const T &value)
+    {
+      static_assert(std::is_trivially_copyable<T>::value, "a key's part is copied byte by byte");
+      const auto *bytes = reinterpret_cast<const unsigned char *>(&value);
+      key.insert(key.end(), bytes, bytes + sizeof(T));
+    }
+
     template <int dim, typename Real>
     struct DeviceEngine<dim, Real>::Impl
     {
-      CudaBackend                  backend;
+      OwnStream                    own_stream;
+      CudaBackend                  backend{own_stream.stream};
       DeviceGrid<dim, Real>        grid;
       DevicePoints<dim, Real>      points;
       PointOrder<dim, Real>        order; // points sorted by stencil every sort_interval steps
@@ -630,6 +691,7 @@ namespace mpm
       bool                         cell_sums_at_nodes = false;
       DeviceArray<std::uint8_t>    block_marks; // blocks holding a point's cell (keep_nodes_near_points)
       QueuedSteps<Real>            queue; // steps queued behind each other (queue_step)
+      StepGraphs                   graphs; // queued steps replayed as CUDA graphs
 
       // The device grid's view, with the averaging's cell arrays where they exist.
       GridView<dim, Real> view()
@@ -685,6 +747,11 @@ namespace mpm
       impl->shape = shape;
       if (const char *from = std::getenv("MPM_CUDA_KERNEL_TIMES"))
         impl->timed_from = std::atol(from);
+      // MPM_CUDA_GRAPHS=0: queued steps launched one kernel at a time (for measuring);
+      // MPM_CUDA_SYNC=1 synchronises after each launch, which a capture cannot.
+      const char *graphs = std::getenv("MPM_CUDA_GRAPHS");
+      const char *sync   = std::getenv("MPM_CUDA_SYNC");
+      impl->graphs.enabled = !(graphs != nullptr && graphs[0] == '0') && !(sync != nullptr && sync[0] == '1');
       // The host grid description: geometry, lookup and masks, nodal arrays zeroed.
       HostGrid<dim, double> host;
       host.h   = g.h;
@@ -886,7 +953,7 @@ namespace mpm
       impl->backend.keep_reductions_on_device = true;
       try
         {
-          run_step(s, Real(0)); // the kernels read the device's time step
+          run_queued_step(s); // the kernels read the device's time step
         }
       catch (...)
         {
@@ -901,6 +968,88 @@ namespace mpm
                                      queued_record_values * sizeof(double), cudaMemcpyDeviceToHost, stream));
       MPM_CUDA_CHECK(cudaEventRecord(q.copied[slot], stream));
       ++q.queued;
+    }
+
+    template <int dim, typename Real>
+    void DeviceEngine<dim, Real>::run_queued_step(const StepSettings<dim, Real> &s)
+    {
+      StepGraphs &graphs = impl->graphs;
+      const bool  sort_due = sort_interval > 0 && impl->steps_since_upload % sort_interval == 0;
+      const bool  timing_due = impl->timed_from >= 0 && impl->n_timed_steps < 5;
+      // Several ranks exchange through the host within the step: no graph there.
+      if (!graphs.enabled || sort_due || timing_due || impl->exchange.exchange != nullptr)
+        {
+          run_step(s, Real(0));
+          return;
+        }
+      // What the step's launches depend on besides the values in device memory.
+      std::vector<unsigned char> key;
+      append_key(key, s);
+      append_key(key, impl->view());
+      append_key(key, impl->points.view());
+      append_key(key, impl->materials.data());
+      append_key(key, impl->shape);
+      append_key(key, impl->hencky);
+      append_key(key, impl->disconnects);
+      append_key(key, impl->averaging_pending);
+      append_key(key, impl->backend.block_size);
+      const cudaStream_t stream = impl->backend.get_stream();
+      ++graphs.uses;
+      if (StepGraphs::Entry *e = graphs.find(key))
+        {
+          MPM_CUDA_CHECK(cudaGraphLaunch(e->exec, stream));
+          ++impl->steps_since_upload; // as run_step does
+          impl->averaging_pending = e->pending_after;
+          e->last_used            = graphs.uses;
+          ++graphs.replays;
+          return;
+        }
+      if (key != graphs.last_direct_key)
+        {
+          // Settings that change every step (a gravity ramp) would capture every step: a
+          // graph only for a step whose launches are those of the step before.
+          run_step(s, Real(0));
+          graphs.last_direct_key = std::move(key);
+          return;
+        }
+      cudaGraph_t graph = nullptr;
+      MPM_CUDA_CHECK(cudaStreamBeginCapture(stream, cudaStreamCaptureModeRelaxed));
+      try
+        {
+          run_step(s, Real(0));
+        }
+      catch (...)
+        {
+          cudaStreamEndCapture(stream, &graph);
+          if (graph != nullptr)
+            cudaGraphDestroy(graph);
+          throw;
+        }
+      MPM_CUDA_CHECK(cudaStreamEndCapture(stream, &graph));
+      StepGraphs::Entry &e = graphs.oldest();
+      if (e.exec != nullptr)
+        MPM_CUDA_CHECK(cudaGraphExecDestroy(e.exec));
+      e.exec = nullptr;
+      const cudaError_t instantiated = cudaGraphInstantiate(&e.exec, graph, 0);
+      cudaGraphDestroy(graph);
+      MPM_CUDA_CHECK(instantiated);
+      e.key           = key;
+      e.pending_after = impl->averaging_pending;
+      e.last_used     = graphs.uses;
+      ++graphs.captures;
+      MPM_CUDA_CHECK(cudaGraphLaunch(e.exec, stream)); // the captured step runs now
+    }
+
+    template <int dim, typename Real>
+    long DeviceEngine<dim, Real>::graph_replays() const
+    {
+      return impl->graphs.replays;
+    }
+
+    template <int dim, typename Real>
+    long DeviceEngine<dim, Real>::graph_captures() const
+    {
+      return impl->graphs.captures;
     }
 
     template <int dim, typename Real>

@@ -19,7 +19,9 @@
 //     queued (the device's time step from the last step's speed, collected one step
 //     behind): each queued step's time step equals the host's rule on the collected speeds
 //     to the bit, the steps and their time steps match the stepped engine's (1e-12), and
-//     the points within 1e-10 as above; a third queued step before a collect is refused;
+//     the points within 1e-10 as above; a third queued step before a collect is refused.
+//     Twice: with P1's gravity ramp (no step replayed as a CUDA graph) and with full gravity
+//     and pressure averaging (the steps between the sorts replayed as graphs);
 //   - the float engine (DeviceEngine<3, float>, Backend/Precision = float) on the same P1 steps:
 //     against the CPU's float step within 1e-5 h in position and 1e-4 of max |v| (float's
 //     round-off, 6e-8, summed in another order), against the double engine within 1e-4 h and
@@ -34,6 +36,7 @@
 #include <algorithm>
 #include <numeric>
 #include <random>
+#include <string>
 
 using namespace mpm;
 using namespace mpm_test;
@@ -99,9 +102,20 @@ void cpdi2q_through_engine()
 }
 
 // Queued steps against stepped ones (the header's list).
+// ramping: P1's gravity ramp (the settings change every step: no graph); otherwise full
+// gravity and pressure averaging (the same launches every step: replayed as CUDA graphs).
 void queued_steps(HostGrid<3, double> grid, const HostPoints<3, double> &points,
-                  const std::vector<MaterialParameters<double>> &materials, StepSettings<3, double> s)
+                  const std::vector<MaterialParameters<double>> &materials, StepSettings<3, double> s,
+                  const bool ramping)
 {
+  const char *label = ramping ? "queued (gravity ramp)" : "queued (graphs)";
+  auto gravity = [&](const double time) {
+    if (ramping)
+      mpm_bench::p1_gravity(s, time);
+    else
+      mpm_bench::p1_gravity(s, 1e300);
+  };
+  s.pressure_averaging = !ramping;
   const double dt0 = mpm_bench::P1::cfl * mpm_bench::P1::h / mpm_bench::p1_wave_speed();
   TimeStepRule rule;
   rule.cfl_times_h      = mpm_bench::P1::cfl * mpm_bench::P1::h;
@@ -125,7 +139,7 @@ void queued_steps(HostGrid<3, double> grid, const HostPoints<3, double> &points,
     while (time < rule.end_time * (1 - 1e-12))
       {
         const double dt = next_time_step(rule, speed, time, next_output);
-        mpm_bench::p1_gravity(s, time);
+        gravity(time);
         speed = finite_or_infinite_speed(stepped.step(s, dt).max_speed);
         stepped_dt.push_back(dt);
         time += dt;
@@ -139,7 +153,7 @@ void queued_steps(HostGrid<3, double> grid, const HostPoints<3, double> &points,
   int landings = 0;
   while (time < rule.end_time * (1 - 1e-12))
     {
-      mpm_bench::p1_gravity(s, time);
+      gravity(time);
       queued.queue_step(s, rule, time, next_output, queued_dt.empty(), speed);
       if (!queued_dt.empty())
         {
@@ -170,17 +184,24 @@ void queued_steps(HostGrid<3, double> grid, const HostPoints<3, double> &points,
         dv    = std::max(dv, std::abs(a.velocity[d][i] - b.velocity[d][i]));
         v_max = std::max(v_max, std::abs(a.velocity[d][i]));
       }
-  std::printf("test_gpu_device_engine: queued steps, %zu steps (stepped: %zu), %d cut to land on an output or the "
-              "end | device's dt against the host's rule: %d differ | dt against the stepped engine's %.1e dt0 | "
-              "points against it: x/h %.1e, v %.1e (max |v| %.2e)\n",
-              queued_dt.size(), stepped_dt.size(), landings, mismatched, ddt, dx, dv / v_max, v_max);
-  check(landings >= 10, "queued: steps cut to land on output times");
-  check(mismatched == 0, "queued: the device's time step equals the host's rule to the bit");
-  check(queued_dt.size() == stepped_dt.size(), "queued: as many steps as stepped");
-  check_below(ddt, 1e-12, "queued: time steps against the stepped engine's (of dt0)");
-  check(v_max > 1e-4, "queued: the points move");
-  check_below(dx, 1e-10, "queued: positions against the stepped engine (x/h)");
-  check_below(dv / v_max, 1e-10, "queued: velocities against the stepped engine (of max |v|)");
+  const long replays = queued.graph_replays(), captures = queued.graph_captures();
+  std::printf("test_gpu_device_engine: %s, %zu steps (stepped: %zu), %d cut to land on an output or the end, "
+              "%ld replayed as a CUDA graph (%ld captures) | device's dt against the host's rule: %d differ | dt "
+              "against the stepped engine's %.1e dt0 | points against it: x/h %.1e, v %.1e (max |v| %.2e)\n",
+              label, queued_dt.size(), stepped_dt.size(), landings, replays, captures, mismatched, ddt, dx,
+              dv / v_max, v_max);
+  const std::string l = std::string(label) + ": ";
+  check(landings >= 10, (l + "steps cut to land on output times").c_str());
+  check(mismatched == 0, (l + "the device's time step equals the host's rule to the bit").c_str());
+  check(queued_dt.size() == stepped_dt.size(), (l + "as many steps as stepped").c_str());
+  check_below(ddt, 1e-12, (l + "time steps against the stepped engine's (of dt0)").c_str());
+  check(v_max > 1e-4, (l + "the points move").c_str());
+  check_below(dx, 1e-10, (l + "positions against the stepped engine (x/h)").c_str());
+  check_below(dv / v_max, 1e-10, (l + "velocities against the stepped engine (of max |v|)").c_str());
+  if (ramping)
+    check(replays == 0, (l + "no graph where the settings change every step").c_str());
+  else // sorts every 20 steps: all but the sorts, the two steps after the first two and the captures
+    check(replays >= 35 && captures <= 4, (l + "the steps between the sorts replayed as graphs").c_str());
 
   // A third queued step before a collect is refused (the host's two pinned slots).
   bool refused = false;
@@ -334,7 +355,8 @@ int main()
   check_below(std::abs(m_sum - m_points) / m_points, 1e-12, "downloaded nodal mass sums to the points' mass");
 
   s.gravity[0] = s.gravity[1] = s.gravity[2] = 0; // p1_gravity sets them again from the start
-  queued_steps(grid, points, materials, s);
+  queued_steps(grid, points, materials, s, true);
+  queued_steps(grid, points, materials, s, false);
   float_engine(grid, points, materials, s, dt, n_steps);
   return finish("test_gpu_device_engine");
 }

@@ -121,6 +121,9 @@ namespace mpm
       // The oldest uncollected queued step's reductions and time step (waits for its end).
       QueuedStep collect_step();
       long       queued_steps() const; // queued and not yet collected
+      // Queued steps replayed as a CUDA graph of an earlier one, and graphs captured.
+      long graph_replays() const;
+      long graph_captures() const;
       PointTotals<dim, double> totals();
       void set_materials(const std::vector<MaterialParameters<double>> &materials);
 
@@ -186,6 +189,8 @@ namespace mpm
       // One step with settings in the device's precision (their time_step_on_device, if set,
       // instead of dt); the reduction as the backend returned it.
       StepReduction<Real> run_step(const StepSettings<dim, Real> &settings, Real dt);
+      // A queued step's launches: run_step's, or a CUDA graph of an earlier step's.
+      void run_queued_step(const StepSettings<dim, Real> &settings);
     };
   } // namespace cuda
 } // namespace mpm
