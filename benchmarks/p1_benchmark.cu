@@ -284,10 +284,11 @@ namespace
     dmaterials.upload(materials);
     const double setup_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
-    // A stream of its own where a step is captured into a graph (the legacy stream cannot be).
+    // A stream of its own where a step is captured into a graph (the legacy stream cannot be);
+    // blocking, so that it stays ordered with the legacy stream's copies, as the engine's.
     cudaStream_t own_stream = nullptr;
     if (opt.launch_mode_steps > 0)
-      MPM_CUDA_CHECK(cudaStreamCreateWithFlags(&own_stream, cudaStreamNonBlocking));
+      MPM_CUDA_CHECK(cudaStreamCreate(&own_stream));
     CudaBackend backend(own_stream);
     backend.block_size = opt.block;
     PointOrder<3, Real> order;

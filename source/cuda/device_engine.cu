@@ -611,6 +611,8 @@ namespace mpm
       Entry &oldest() { return entries[0].last_used <= entries[1].last_used ? entries[0] : entries[1]; }
       void   clear()
       {
+        if (entries[0].exec != nullptr || entries[1].exec != nullptr)
+          cudaDeviceSynchronize(); // no graph destroyed while it runs (errors ignored: destructor)
         for (Entry &e : entries)
           {
             if (e.exec != nullptr)
@@ -938,8 +940,10 @@ namespace mpm
       QueuedSteps<Real> &q = impl->queue;
       if (q.queued - q.collected >= 2)
         throw std::logic_error("DeviceEngine::queue_step: two queued steps are not collected yet (collect_step)");
-      if (!speed_from_host && q.queued == 0)
-        throw std::logic_error("DeviceEngine::queue_step: the first queued step needs the host's speed");
+      // The device's speed is the last record's: only that of the one step queued just before.
+      if (!speed_from_host && q.queued - q.collected != 1)
+        throw std::logic_error("DeviceEngine::queue_step: the speed from the device needs the step before queued "
+                               "and not yet collected; otherwise speed_from_host");
       q.allocate();
       const int          slot   = static_cast<int>(q.queued % 2);
       double            *record = q.records.data() + slot * queued_record_values;
@@ -1028,7 +1032,10 @@ namespace mpm
       MPM_CUDA_CHECK(cudaStreamEndCapture(stream, &graph));
       StepGraphs::Entry &e = graphs.oldest();
       if (e.exec != nullptr)
-        MPM_CUDA_CHECK(cudaGraphExecDestroy(e.exec));
+        {
+          MPM_CUDA_CHECK(cudaStreamSynchronize(stream)); // the graph may still run a step queued before
+          MPM_CUDA_CHECK(cudaGraphExecDestroy(e.exec));
+        }
       e.exec = nullptr;
       const cudaError_t instantiated = cudaGraphInstantiate(&e.exec, graph, 0);
       cudaGraphDestroy(graph);

@@ -19,7 +19,8 @@
 //     queued (the device's time step from the last step's speed, collected one step
 //     behind): each queued step's time step equals the host's rule on the collected speeds
 //     to the bit, the steps and their time steps match the stepped engine's (1e-12), and
-//     the points within 1e-10 as above; a third queued step before a collect is refused.
+//     the points within 1e-10 as above; a third queued step before a collect is refused, and
+//     so is the device's speed where no step is queued before.
 //     Twice: with P1's gravity ramp (no step replayed as a CUDA graph) and with full gravity
 //     and pressure averaging (the steps between the sorts replayed as graphs);
 //   - the float engine (DeviceEngine<3, float>, Backend/Precision = float) on the same P1 steps:
@@ -218,6 +219,17 @@ void queued_steps(HostGrid<3, double> grid, const HostPoints<3, double> &points,
   queued.collect_step();
   queued.collect_step();
   check(refused, "queue_step refuses a third uncollected step");
+  // With every step collected, the device's last record is no step's before: refused too.
+  bool stale_refused = false;
+  try
+    {
+      queued.queue_step(s, rule, 0, interval, false, 0);
+    }
+  catch (const std::logic_error &)
+    {
+      stale_refused = true;
+    }
+  check(stale_refused && queued.queued_steps() == 0, "queue_step refuses the device's speed with no step queued");
 }
 
 // The float engine on P1's steps, against the CPU's float step and the double engine.

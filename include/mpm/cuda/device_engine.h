@@ -112,10 +112,13 @@ namespace mpm
       StepReduction<double> step(const StepSettings<dim, double> &settings, double dt);
 
       // A step queued behind the last one without waiting for it: its time step is computed
-      // on the device by rule (time_step_rule.h) from the last queued step's largest speed
-      // or, with speed_from_host, from host_speed (the first step queued after a step()
-      // or a load). time and next_output are the step's start and the next output time.
-      // At most two queued steps may be uncollected; step() needs none.
+      // on the device by rule (time_step_rule.h) from the largest speed of the step queued
+      // just before (which must be the one uncollected step) or, with speed_from_host, from
+      // host_speed (any other time: the first step, after a collect, a step() or a load).
+      // time and next_output are the step's start and the next output time. At most two
+      // queued steps may be uncollected, and step() needs none; collect every queued step
+      // before reading or changing the points. Misuse throws std::logic_error. Steps whose
+      // launches repeat the step before's are replayed as CUDA graphs (MPM_CUDA_GRAPHS=0: not).
       void queue_step(const StepSettings<dim, double> &settings, const TimeStepRule &rule, double time,
                       double next_output, bool speed_from_host, double host_speed);
       // The oldest uncollected queued step's reductions and time step (waits for its end).
