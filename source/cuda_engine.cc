@@ -17,6 +17,7 @@
 
 #  include <algorithm>
 #  include <chrono>
+#  include <cstdlib>
 #  include <iostream>
 #  include <map>
 #  include <type_traits>
@@ -286,8 +287,30 @@ namespace mpm
       // contract), which is the labels' order.
       void snapshot(PointSnapshot<dim> &s) override
       {
+        s.wait_for_points(); // nothing left to overwrite these points later
         s.points.resize(device->n_points());
         device->download_points(s.points);
+        take_labels(s);
+      }
+
+      // The points come down while the steps go on (DeviceEngine::begin_download_points);
+      // s.wait_for_points() finishes it. MPM_OUTPUT_OVERLAP=0 waits here instead (for measuring).
+      void start_snapshot(PointSnapshot<dim> &s) override
+      {
+        static const bool overlap = [] {
+          const char *v = std::getenv("MPM_OUTPUT_OVERLAP");
+          return !(v != nullptr && v[0] == '0');
+        }();
+        if (!overlap)
+          return snapshot(s);
+        s.wait_for_points(); // an earlier download nobody read
+        s.arrival = device->begin_download_points(s.points);
+        take_labels(s);
+      }
+
+      // The labels of the points as they come down.
+      void take_labels(PointSnapshot<dim> &s)
+      {
         if (labels_on_device_only)
           {
             // Re-sorts moved the labels on the device: they come down in upload order.

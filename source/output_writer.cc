@@ -500,6 +500,7 @@ namespace mpm
   PointSnapshot<dim> &OutputWriter<dim>::next_snapshot()
   {
     finish();
+    snapshot.wait_for_points(); // a download that no task read (neither particles nor table written)
     return snapshot;
   }
 
@@ -546,6 +547,7 @@ namespace mpm
       run_all(writes);
     };
     auto point_task = [this, K, counter = counter, records = particle_records]() {
+      snapshot.wait_for_points();
       if (write_particles)
         {
           std::vector<std::function<void()>> writes;

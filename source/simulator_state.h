@@ -891,14 +891,18 @@ namespace mpm
         }
       join_grid();
       dealii::TimerOutput::Scope scope(timer, "output");
-      engine->snapshot(output->next_snapshot());
+      PointSnapshot<dim> &snapshot = output->next_snapshot();
+      // The nodes first: their download waits for the device, the points' does not (the
+      // CUDA engine's come down while the next steps are queued; the particle task waits).
       if (!grid) // one rank, nodes near the material: the grid files show the engine's cells
         {
           typename GridSnapshot<dim>::LatticeCells cells;
           engine->cells_with_mass(cells);
+          engine->start_snapshot(snapshot);
           return output->write_fields(time, std::move(cells));
         }
       engine->nodal_to(*grid);
+      engine->start_snapshot(snapshot);
       output->write_fields(time, *grid);
     }
   };

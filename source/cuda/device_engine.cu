@@ -14,6 +14,7 @@
 #include <cub/device/device_select.cuh>
 
 #include <algorithm>
+#include <atomic>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -624,6 +625,50 @@ namespace mpm
       ~StepGraphs() { clear(); }
     };
 
+    // Pinned host memory that output downloads (begin_download_points) come down into while
+    // the steps go on, and the event that marks their copies done. Shared with the function
+    // that finishes a download, so that it stays valid if the engine is gone first.
+    template <typename Real>
+    struct OutputDownload
+    {
+      Real             *reals = nullptr;
+      int              *ints  = nullptr;
+      std::size_t       n_reals = 0, n_ints = 0; // capacities
+      cudaEvent_t       copied  = nullptr;
+      std::atomic<bool> unfinished{false}; // begun, its function not run yet
+
+      OutputDownload() { MPM_CUDA_CHECK(cudaEventCreateWithFlags(&copied, cudaEventDisableTiming)); }
+      OutputDownload(const OutputDownload &) = delete;
+      ~OutputDownload()
+      {
+        cudaEventSynchronize(copied); // no pinned memory freed under a copy (errors ignored: destructor)
+        cudaEventDestroy(copied);
+        cudaFreeHost(reals);
+        cudaFreeHost(ints);
+      }
+
+      // Room for at least the given numbers of values; the last copies are done.
+      void reserve(const std::size_t reals_needed, const std::size_t ints_needed)
+      {
+        grow(reals, n_reals, reals_needed);
+        grow(ints, n_ints, ints_needed);
+      }
+
+    private:
+      template <typename T>
+      void grow(T *&buffer, std::size_t &capacity, const std::size_t needed)
+      {
+        if (needed <= capacity)
+          return;
+        MPM_CUDA_CHECK(cudaEventSynchronize(copied));
+        MPM_CUDA_CHECK(cudaFreeHost(buffer));
+        buffer   = nullptr;
+        capacity = 0;
+        MPM_CUDA_CHECK(cudaMallocHost(&buffer, needed * sizeof(T)));
+        capacity = needed;
+      }
+    };
+
     // Appends the bytes of a value to a key.
     template <typename T>
     void append_key(std::vector<unsigned char> &key, const T &value)
@@ -694,6 +739,7 @@ namespace mpm
       DeviceArray<std::uint8_t>    block_marks; // blocks holding a point's cell (keep_nodes_near_points)
       QueuedSteps<Real>            queue; // steps queued behind each other (queue_step)
       StepGraphs                   graphs; // queued steps replayed as CUDA graphs
+      std::shared_ptr<OutputDownload<Real>> output_download; // begin_download_points, from the first
 
       // The device grid's view, with the averaging's cell arrays where they exist.
       GridView<dim, Real> view()
@@ -883,6 +929,45 @@ namespace mpm
           impl->order.download_in_reference_order(impl->backend, impl->points, rounded);
           convert_points<double>(rounded, p);
         }
+    }
+
+    template <int dim, typename Real>
+    std::function<void()> DeviceEngine<dim, Real>::begin_download_points(HostPoints<dim, double> &p)
+    {
+      if (!impl->output_download)
+        impl->output_download = std::make_shared<OutputDownload<Real>>();
+      const std::shared_ptr<OutputDownload<Real>> download = impl->output_download;
+      if (download->unfinished)
+        throw std::logic_error("DeviceEngine::begin_download_points: the last download was not finished (call the "
+                               "function it returned first)");
+      impl->finish_pending_averaging();
+      const DevicePoints<dim, Real> &points = impl->points;
+      const int                      n      = points.size();
+      p.resize(n);
+      if (p.n_state_variables() < points.n_state_variables())
+        p.set_n_state_variables(points.n_state_variables());
+      // Where each array lands on the host, in the order the copies fill the pinned memory.
+      std::vector<double *> real_to;
+      std::vector<int *>    int_to;
+      for_each_point_array<dim>(points, p, [&](const auto &device, auto &host) {
+        using T = typename std::decay_t<decltype(device)>::value_type;
+        if constexpr (std::is_same<T, int>::value)
+          int_to.push_back(host.data());
+        else
+          real_to.push_back(host.data());
+      });
+      download->reserve(real_to.size() * std::size_t(n), int_to.size() * std::size_t(n));
+      impl->order.queue_download_in_reference_order(impl->backend, points, download->reals, download->ints);
+      MPM_CUDA_CHECK(cudaEventRecord(download->copied, impl->backend.get_stream()));
+      download->unfinished = true;
+      return [download, n, real_to = std::move(real_to), int_to = std::move(int_to)]() {
+        MPM_CUDA_CHECK(cudaEventSynchronize(download->copied));
+        for (std::size_t k = 0; k < real_to.size(); ++k)
+          std::copy(download->reals + k * n, download->reals + (k + 1) * n, real_to[k]); // float: to double
+        for (std::size_t k = 0; k < int_to.size(); ++k)
+          std::copy(download->ints + k * n, download->ints + (k + 1) * n, int_to[k]);
+        download->unfinished = false;
+      };
     }
 
     template <int dim, typename Real>

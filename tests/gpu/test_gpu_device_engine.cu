@@ -27,7 +27,10 @@
 //     against the CPU's float step within 1e-5 h in position and 1e-4 of max |v| (float's
 //     round-off, 6e-8, summed in another order), against the double engine within 1e-4 h and
 //     1e-3 (and not equal to it: the step did run in float); its totals summed in double, the
-//     mass within 1e-7 of the double points' (each mass rounded once).
+//     mass within 1e-7 of the double points' (each mass rounded once);
+//   - an output's download while the steps go on (begin_download_points), in double and in
+//     float: the points as at its beginning after 45 more steps were queued behind it (against
+//     a second engine, as above), and a second download before the first is refused.
 #include "../core/check.h"
 #include "gpu_scenes.h"
 
@@ -38,6 +41,8 @@
 #include <numeric>
 #include <random>
 #include <string>
+#include <type_traits>
+#include <utility>
 
 using namespace mpm;
 using namespace mpm_test;
@@ -232,6 +237,87 @@ void queued_steps(HostGrid<3, double> grid, const HostPoints<3, double> &points,
   check(stale_refused && queued.queued_steps() == 0, "queue_step refuses the device's speed with no step queued");
 }
 
+// An output's download that does not hold up the steps (begin_download_points): begun after
+// `n_steps` steps with the pressure averaging still pending, then steps queued at once and
+// replayed as graphs, and only then waited for. It must hold the points as they were at its
+// beginning: against a second engine stepped as far and downloaded the waiting way
+// (download_points), within the agreement of two engines (reordered atomic sums), and far
+// from the points after the later steps. A second download before the first is finished is
+// refused.
+template <typename Real>
+void download_while_stepping(HostGrid<3, double> grid, const HostPoints<3, double> &points,
+                             const std::vector<MaterialParameters<double>> &materials, StepSettings<3, double> s,
+                             const double dt, const int n_steps, const double tolerance)
+{
+  const char *label = std::is_same<Real, double>::value ? "download while stepping" : "download while stepping (float)";
+  mpm::cuda::DeviceEngine<3, Real> engine(grid.view(), materials, ShapeFunction::gimp);
+  mpm::cuda::DeviceEngine<3, Real> reference(grid.view(), materials, ShapeFunction::gimp);
+  engine.upload_points(points);
+  reference.upload_points(points);
+  double time = 0;
+  for (int step = 0; step < n_steps; ++step, time += dt)
+    {
+      mpm_bench::p1_gravity(s, time);
+      engine.step(s, dt);
+      reference.step(s, dt);
+    }
+  HostPoints<3, double> begun, refused_into;
+  auto                  arrive  = engine.begin_download_points(begun);
+  bool                  refused = false;
+  try
+    {
+      engine.begin_download_points(refused_into);
+    }
+  catch (const std::logic_error &)
+    {
+      refused = true;
+    }
+
+  mpm_bench::p1_gravity(s, 1e300); // the same launches every step: graphs
+  TimeStepRule rule;
+  rule.cfl_times_h = mpm_bench::P1::cfl * mpm_bench::P1::h;
+  rule.wave_speed  = mpm_bench::p1_wave_speed();
+  rule.end_time    = 1e300;
+  const int n_later = 45;
+  for (int k = 0; k < n_later; ++k)
+    {
+      engine.queue_step(s, rule, time, 1e300, k == 0, 0);
+      if (k > 0)
+        time += engine.collect_step().dt;
+    }
+  time += engine.collect_step().dt;
+  arrive();
+
+  HostPoints<3, double> expected, later;
+  reference.download_points(expected);
+  engine.download_points(later);
+  auto largest_difference = [&](const HostPoints<3, double> &a, const HostPoints<3, double> &b) {
+    double dx = 0, dsigma = 0, sigma_max = 0;
+    for (int i = 0; i < points.size(); ++i)
+      {
+        for (int d = 0; d < 3; ++d)
+          dx = std::max(dx, std::abs(a.position[d][i] - b.position[d][i]) / mpm_bench::P1::h);
+        for (int c = 0; c < n_voigt; ++c)
+          {
+            dsigma    = std::max(dsigma, std::abs(a.stress[c][i] - b.stress[c][i]));
+            sigma_max = std::max(sigma_max, std::abs(b.stress[c][i]));
+          }
+      }
+    return std::make_pair(dx, dsigma / sigma_max);
+  };
+  const auto [dx, dsigma]             = largest_difference(begun, expected);
+  const auto [dx_later, dsigma_later] = largest_difference(begun, later);
+  std::printf("test_gpu_device_engine: %s, begun after %d steps, waited for after %d more | against a second "
+              "engine's download: x/h %.1e, stress %.1e | against the points after them: x/h %.1e\n",
+              label, n_steps, n_later, dx, dsigma, dx_later);
+  const std::string l = std::string(label) + ": ";
+  check(refused, (l + "a second download before the first is finished is refused").c_str());
+  check(begun.size() == points.size(), (l + "every point downloaded").c_str());
+  check_below(dx, tolerance, (l + "positions as at the download's beginning (x/h)").c_str());
+  check_below(dsigma, 100 * tolerance, (l + "stresses as at the download's beginning (of max |sigma|)").c_str());
+  check(dx_later > 1e3 * tolerance, (l + "the later steps moved the points (and did not reach the download)").c_str());
+}
+
 // The float engine on P1's steps, against the CPU's float step and the double engine.
 void float_engine(HostGrid<3, double> grid, const HostPoints<3, double> &points,
                   const std::vector<MaterialParameters<double>> &materials, StepSettings<3, double> s, const double dt,
@@ -370,5 +456,7 @@ int main()
   queued_steps(grid, points, materials, s, true);
   queued_steps(grid, points, materials, s, false);
   float_engine(grid, points, materials, s, dt, n_steps);
+  download_while_stepping<double>(grid, points, materials, s, dt, 30, 1e-10);
+  download_while_stepping<float>(grid, points, materials, s, dt, 30, 1e-5);
   return finish("test_gpu_device_engine");
 }

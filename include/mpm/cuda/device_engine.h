@@ -20,6 +20,7 @@
 #include <mpm/core/views.h>
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -95,6 +96,13 @@ namespace mpm
       // last step's pressure averaging, which the engine leaves to the next step's P2G,
       // is applied first.
       void download_points(HostPoints<dim, double> &points) const;
+      // The same without waiting (output while the steps go on): the download is queued on
+      // the engine's stream into pinned host memory, and steps queued afterwards follow it
+      // there; `points` is sized now. The returned function waits for the copy and fills
+      // `points` from it; call it once, from any thread, before reading them and before the
+      // next begin_download_points (which throws std::logic_error otherwise). The pinned
+      // memory (as many bytes as the points hold on the device) is kept for later downloads.
+      std::function<void()> begin_download_points(HostPoints<dim, double> &points);
       // The device re-sorts its points by stencil every `steps` steps (0: never), so
       // that the nodal sums of a warp are reduced before the atomics; default 20.
       void set_sort_interval(int steps);

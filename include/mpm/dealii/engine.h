@@ -103,6 +103,10 @@ namespace mpm
     // points that left the grid included with material < 0) and sets snapshot.labels.
     // The handler is not touched.
     virtual void snapshot(PointSnapshot<dim> &snapshot) = 0;
+    // The same, where the engine can, without waiting for the points: they arrive in
+    // snapshot.wait_for_points(), which must run before they are read and before the next
+    // snapshot into the same object. The CUDA engine's steps go on meanwhile.
+    virtual void start_snapshot(PointSnapshot<dim> &snapshot) { this->snapshot(snapshot); }
     // For output: brings the grid's nodal vectors (mass, velocity) up to date where the
     // engine keeps its own nodes. Before the first step every nodal field is zero, in the
     // engine as in a grid just built.

@@ -72,6 +72,19 @@ namespace mpm
   {
     HostPoints<dim, double>                  points;
     std::shared_ptr<const PointLabels<dim>> labels;
+    // Set while the points are still on their way (Engine::start_snapshot): fills them.
+    std::function<void()> arrival;
+
+    // Waits for the points where they are still on their way; then they can be read.
+    void wait_for_points()
+    {
+      if (arrival)
+        {
+          const auto arrive = std::move(arrival);
+          arrival           = nullptr;
+          arrive();
+        }
+    }
 
     // Property array of point i in the handler's layout (PropertyLayout): the values the
     // handler would hold after a hand-over. values holds

@@ -5,7 +5,8 @@
 // not from the ParticleHandler: no hand-over, no re-sort per output. Their content is what
 // deal.II's Particles::DataOut writes for the handler (same names, components, values;
 // tests/dealii/test_output_paths.cc asserts it). What the files show is copied when the output
-// is asked for (the snapshot, the nodal vectors); building the patches, compressing and
+// is asked for (the snapshot, the nodal vectors; the CUDA engine's points may still be
+// coming down, and the particle task waits for them); building the patches, compressing and
 // writing can then run on two background threads (grid, particles) while the steps go on
 // (Output/Write in background). The DoFHandler is read there as it is: a repartition must
 // call finish() first.
@@ -144,8 +145,9 @@ namespace mpm
     // Waits for a write in flight; an error there is reported by finish(), not here.
     ~OutputWriter();
 
-    // The snapshot the next write_fields() writes: fill it (Engine::snapshot) right
-    // before. Waits for the write in flight that still reads it.
+    // The snapshot the next write_fields() writes: fill it (Engine::snapshot, or
+    // Engine::start_snapshot: the particle task waits for the points) right before. Waits
+    // for the write in flight that still reads it.
     PointSnapshot<dim> &next_snapshot();
 
     // Writes grid and particle files for time t (rank 0 writes the .pvtu and .pvd records,

@@ -185,6 +185,39 @@ namespace mpm
       });
     }
 
+    // The same queued on the backend's stream, nothing waited for: each array put back in the
+    // reference order into the scratch array, then copied from there to the host, array k
+    // of its type (for_each_point_array's order) to to_reals + k n or to_ints + k n. Those
+    // must be pinned memory (cudaMallocHost) for the copies to be queued; launches queued
+    // later on the stream start after them.
+    void queue_download_in_reference_order(CudaBackend &backend, const DevicePoints<dim, Real> &points,
+                                           Real *to_reals, int *to_ints)
+    {
+      const int n = points.size();
+      if (static_cast<int>(original.size()) != n)
+        throw std::logic_error(
+          "PointOrder::queue_download_in_reference_order: the order was not reset for these points");
+      if (n == 0)
+        return;
+      long k_real = 0, k_int = 0;
+      for_each_point_array<dim>(points, points, [&](const auto &device, const auto &) {
+        auto &scratch = scratch_for(device);
+        scratch.resize(n); // where it grows, cudaFree waits for the copies queued before
+        const int threads = 256;
+        cuda_detail::scatter_kernel<<<(n + threads - 1) / threads, threads, 0, backend.get_stream()>>>(
+          n, original.data(), device.data(), scratch.data());
+        MPM_CUDA_CHECK_LAUNCH();
+        using T = typename std::decay_t<decltype(device)>::value_type;
+        T *to   = nullptr;
+        if constexpr (std::is_same<T, int>::value)
+          to = to_ints + n * k_int++;
+        else
+          to = to_reals + n * k_real++;
+        MPM_CUDA_CHECK(cudaMemcpyAsync(to, scratch.data(), n * sizeof(T), cudaMemcpyDeviceToHost,
+                                       backend.get_stream()));
+      });
+    }
+
     // For each slot, the index its point had at the last reset() (the upload order).
     const int *original_index() const { return original.data(); }
 
