@@ -3,8 +3,10 @@
 # (prm/granular_collapse_3d.prm, Backend = cuda) as it is (`k8`: Output/Files per rank = 8), with 16 pieces per
 # output (`k16`), with 4 (`k4`), and with 8 pieces of the position, velocity and stress only (`fields`: Output/
 # Particle fields = velocity, stress), in turn, ROUNDS times; each with the program's wall time, the timer's
-# output row and the wait at the end for the last output's files.
-#   BIN=dir [ROUNDS=2] bash scripts/gpu_p2_output_settings.sh    (dir: dealii-mpm, libdealii-mpm.so*)
+# output row and the wait at the end for the last output's files. `k8-noyield` and `k16-noyield`: 8 and 16 pieces
+# with the output threads at the steps' priority (MPM_OUTPUT_YIELD=0).
+#   BIN=dir [ROUNDS=2] [WAYS="k8 k16 k4 fields"] bash scripts/gpu_p2_output_settings.sh
+# (dir: dealii-mpm, libdealii-mpm.so*)
 set -u -o pipefail
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
 BIN=$(cd "${BIN:?BIN: the folder with the CUDA build of dealii-mpm}" && pwd)
@@ -12,11 +14,11 @@ OUT=${OUT:-$ROOT/out}
 mkdir -p "$OUT"
 . "$ROOT/scripts/gpu_unpack_build.sh"
 prepare_build "$BIN" "$OUT"
-ways="k8 k16 k4 fields"
+ways=${WAYS:-k8 k16 k4 fields}
 for way in $ways; do
   case $way in
-    k8) extra=("  set Files per rank = 8") ;;
-    k16) extra=("  set Files per rank = 16") ;;
+    k8 | k8-noyield) extra=("  set Files per rank = 8") ;;
+    k16 | k16-noyield) extra=("  set Files per rank = 16") ;;
     k4) extra=("  set Files per rank = 4") ;;
     fields) extra=("  set Files per rank = 8" "  set Particle fields = velocity, stress") ;;
   esac
@@ -29,7 +31,9 @@ for round in $(seq "${ROUNDS:-2}"); do
     rm -rf /tmp/s-$way
     log=$OUT/p2_${way}_$round.log
     t0=$(date +%s.%N)
-    "$BIN/dealii-mpm" /tmp/s_$way.prm >"$log" 2>&1
+    yield=1
+    case $way in *-noyield) yield=0 ;; esac
+    MPM_OUTPUT_YIELD=$yield "$BIN/dealii-mpm" /tmp/s_$way.prm >"$log" 2>&1
     rc=$?
     t1=$(date +%s.%N)
     printf 'round %d %-6s rc=%d shell %.2f s | %s | %s | %s | files %s\n' "$round" $way $rc \
