@@ -66,10 +66,11 @@ namespace mpm
       dealii::DataOutBase::write_pvd_record(pvd, records);
     }
 
-    // A background output thread gives way to the steps: where the writing threads are as many
-    // as the cores, the thread that queues the GPU's steps (or the CPU's step threads) would
-    // otherwise wait for a core. Linux: the calling thread's nice value, which the threads it
-    // starts inherit; elsewhere, and with MPM_OUTPUT_YIELD=0 (for measuring), nothing.
+    // A background output thread gives way to the GPU's steps: where the writing threads are as
+    // many as the cores, the thread that queues the steps would otherwise wait for a core.
+    // Linux: the calling thread's nice value, which the threads it starts inherit; elsewhere,
+    // and with MPM_OUTPUT_YIELD=0 (for measuring), nothing. Not for the CPU backend, whose
+    // step threads (TBB's, started on first use, perhaps from such a thread) must not inherit it.
     void yield_to_the_steps()
     {
 #ifdef __linux__
@@ -423,6 +424,7 @@ namespace mpm
     , background(parameters.output_in_background)
     , particle_fields(parameters.particle_fields)
     , pieces_per_rank(parameters.output_files_per_rank)
+    , yield_to_steps(parameters.backend == "cuda")
   {
     if (output_directory.empty())
       output_directory = ".";
@@ -609,8 +611,9 @@ namespace mpm
                                 .count();
         };
         if (background)
-          in_flight.push_back(std::async(std::launch::async, [timed]() {
-            yield_to_the_steps();
+          in_flight.push_back(std::async(std::launch::async, [timed, yield = yield_to_steps]() {
+            if (yield)
+              yield_to_the_steps();
             timed();
           }));
         else

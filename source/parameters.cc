@@ -443,9 +443,10 @@ namespace mpm
                       "best compression (doc/performance.md, Output).");
     prm.declare_entry("Write in background", "true", Patterns::Bool(),
                       "Build, compress and write the output files on a background thread while the steps go on; "
-                      "the points are copied first (one snapshot), so the steps cannot change what is written. On "
-                      "Linux these threads run at a lower priority (nice 10), so that they do not take the steps' "
-                      "cores. false: the run waits for each output to be written.");
+                      "the points are copied first (one snapshot), so the steps cannot change what is written. With "
+                      "Backend = cuda on Linux these threads run at a lower priority (nice 10), so that they do not "
+                      "take the core of the thread that queues the steps. false: the run waits for each output to "
+                      "be written.");
     prm.declare_entry("Files per rank", "1", Patterns::Integer(1, 256),
                       "Each rank writes its grid cells and its points as this many .vtu pieces per output (the "
                       ".pvtu record lists them all), built, compressed and written on as many threads: more than "

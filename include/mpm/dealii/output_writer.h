@@ -207,6 +207,7 @@ namespace mpm
     bool                              write_grid, write_particles, write_table, background;
     std::vector<std::string>          particle_fields; // empty: all
     unsigned int                      pieces_per_rank; // .vtu files per rank and output
+    bool                              yield_to_steps; // Backend = cuda: background threads at a lower priority
     dealii::DataOutBase::VtkFlags     vtk_flags;
     unsigned int                      counter = 0;
     std::vector<std::pair<double, std::string>> grid_records, particle_records;
