@@ -19,7 +19,8 @@
 //   --material elastic|dp   linear elastic stand-in, or ep2-3De's Drucker-Prager (default dp)
 //   --sort-every N          sort the points by stencil on the device every N steps (0: never;
 //                           default 20), so that the warp adders reduce runs of shared nodes
-//   --shape gimp|linear|bspline2|bspline3|cpdi   the shape function (default gimp)
+//   --shape gimp|linear|bspline2|bspline3|bspline3gimp|cpdi   the shape function (default gimp;
+//                                                bspline3gimp: the cubic B-spline GIMP, --domain as for GIMP)
 //   --domain detF|Fii|U|none                GIMP's domain update (default detF, P1's own)
 //   --launch-modes N        after the timed run, N steps at a fixed time step three ways: the
 //                           reduction read back after every step (as the programs run), never
@@ -302,13 +303,17 @@ namespace
         order.template sort<LinearShape>(backend, gv, dpoints);
       else if (opt.shape == ShapeFunction::bspline3)
         order.template sort<CubicBSplineShape>(backend, gv, dpoints);
+      else if (opt.shape == ShapeFunction::bspline3_gimp)
+        order.template sort<CubicBSplineGimpShape>(backend, gv, dpoints);
       else // GIMP and the quadratic B-spline share the stencil's first node
         order.template sort<GimpShape>(backend, gv, dpoints);
       pv = dpoints.view();
       return true;
     };
     StepSettings<3, Real> s = mpm_bench::p1_settings<Real>();
-    s.domain_update         = opt.shape == ShapeFunction::gimp ? opt.domain : DomainUpdate::none;
+    s.domain_update         = opt.shape == ShapeFunction::gimp || opt.shape == ShapeFunction::bspline3_gimp ?
+                                opt.domain :
+                                DomainUpdate::none;
     if (opt.affine)
       {
         s.affine_state_variable = 0;
@@ -393,8 +398,9 @@ namespace
     label += opt.shape == ShapeFunction::linear   ? ", linear" :
              opt.shape == ShapeFunction::bspline2 ? ", B-spline" :
              opt.shape == ShapeFunction::bspline3 ? ", cubic B-spline" :
+             opt.shape == ShapeFunction::bspline3_gimp ? ", cubic B-spline GIMP" :
              opt.shape == ShapeFunction::cpdi     ? ", CPDI" : "";
-    if (opt.shape == ShapeFunction::gimp)
+    if (opt.shape == ShapeFunction::gimp || opt.shape == ShapeFunction::bspline3_gimp)
       label += opt.domain == DomainUpdate::U ? ", U domains" : opt.domain == DomainUpdate::stretch ? ", F_ii domains" :
                opt.domain == DomainUpdate::none ? ", uGIMP" : ", det F domains";
     if (opt.affine)
@@ -493,15 +499,18 @@ int main(int argc, char **argv)
       else if (a == "--shape" && i + 1 < argc)
         {
           const std::string m = argv[++i];
-          if (m != "gimp" && m != "linear" && m != "bspline2" && m != "bspline3" && m != "cpdi")
+          if (m != "gimp" && m != "linear" && m != "bspline2" && m != "bspline3" && m != "bspline3gimp" &&
+              m != "cpdi")
             {
-              std::printf("--shape: expected gimp, linear, bspline2, bspline3 or cpdi, got %s\n", m.c_str());
+              std::printf("--shape: expected gimp, linear, bspline2, bspline3, bspline3gimp or cpdi, got %s\n",
+                          m.c_str());
               return 2;
             }
-          opt.shape = m == "gimp"     ? ShapeFunction::gimp :
-                      m == "linear"   ? ShapeFunction::linear :
-                      m == "bspline2" ? ShapeFunction::bspline2 :
-                      m == "cpdi"     ? ShapeFunction::cpdi : ShapeFunction::bspline3;
+          opt.shape = m == "gimp"         ? ShapeFunction::gimp :
+                      m == "linear"       ? ShapeFunction::linear :
+                      m == "bspline2"     ? ShapeFunction::bspline2 :
+                      m == "bspline3gimp" ? ShapeFunction::bspline3_gimp :
+                      m == "cpdi"         ? ShapeFunction::cpdi : ShapeFunction::bspline3;
         }
       else if (a == "--domain" && i + 1 < argc)
         {
@@ -557,14 +566,15 @@ int main(int argc, char **argv)
         {
           std::printf("usage: %s [--fp32] [--sizes 20,160,640,2560] [--steps N] [--profile] [--table FILE]\n"
                       "          [--order generated|cell|random] [--block N] [--material dp|elastic] [--sort-every N]\n"
-                      "          [--shape gimp|linear|bspline2|bspline3|cpdi] [--domain detF|Fii|U|none]\n"
+                      "          [--shape gimp|linear|bspline2|bspline3|bspline3gimp|cpdi] [--domain detF|Fii|U|none]\n"
                       "          [--transfer tpic|apic] [--law jaumann|hencky] [--launch-modes N]\n",
                       argv[0]);
           return 2;
         }
     }
   if (opt.affine && opt.affine_matrix == AffineMatrix::b_d_inverse &&
-      (opt.shape == ShapeFunction::gimp || opt.shape == ShapeFunction::cpdi))
+      (opt.shape == ShapeFunction::gimp || opt.shape == ShapeFunction::bspline3_gimp ||
+       opt.shape == ShapeFunction::cpdi))
     {
       std::printf("--transfer apic: needs --shape linear, bspline2 or bspline3 (GIMP has no constant D_p; use "
                   "--transfer tpic)\n");

@@ -232,22 +232,26 @@ namespace mpm
     prm.declare_entry("Update scheme", "MUSL", Patterns::Selection("MUSL|USL|USF"),
                       "Explicit update scheme: MUSL (modified update stress last, default), USL or USF.");
     prm.declare_entry("Shape function", "GIMP",
-                      Patterns::Selection("linear|GIMP|quadratic B-spline|cubic B-spline|CPDI|CPDI2q"),
+                      Patterns::Selection("linear|GIMP|quadratic B-spline|cubic B-spline|cubic B-spline GIMP|CPDI|"
+                                          "CPDI2q"),
                       "Grid shape functions: linear (standard MPM), GIMP (generalised interpolation), "
                       "quadratic B-spline (C1, three nodes per direction; within half a cell of the grid's "
                       "faces it becomes linear, doc/theory.md), cubic B-spline (C2, four nodes per direction, "
                       "the same treatment at the faces; in MPI runs the points are re-sorted whenever one "
-                      "leaves its cell), CPDI (the linear hats averaged over each point's parallelogram or "
+                      "leaves its cell), cubic B-spline GIMP (the cubic B-spline averaged over each point's "
+                      "axis-aligned domain, five nodes per direction; with GIMP domain update = F_ii, det F or U "
+                      "the domains follow the deformation), CPDI (the linear hats averaged over each point's "
+                      "parallelogram or "
                       "parallelepiped domain, whose edges follow F, including its rotation and shear) or CPDI2q "
                       "(2D: the same over a quadrilateral whose four corners move with the grid's velocity). "
-                      "CPDI and CPDI2q: one MPI rank, Grid/Nodes = all.");
+                      "Cubic B-spline GIMP, CPDI and CPDI2q: one MPI rank, Grid/Nodes = all.");
     prm.declare_entry("GIMP domain update", "none", Patterns::Selection("none|det F|F_ii|U"),
                       "How GIMP particle domains follow the deformation: none (uGIMP), det F (cpGIMP, "
                       "half-lengths scaled by det(F)^(1/dim)), F_ii (cpGIMP, half-length i scaled by F_ii; exact "
                       "for stretch along the axes, the domain vanishes under a rotation by 90 degrees) or U "
                       "(cpGIMP, half-length i scaled by U_ii, U the stretch tensor of the polar decomposition "
                       "F = R U: F_ii's accuracy under stretch, unchanged by rotation). Only with Shape function = "
-                      "GIMP.");
+                      "GIMP or cubic B-spline GIMP.");
     prm.declare_entry("Time step", "adaptive", Patterns::Selection("adaptive|fixed"),
                       "adaptive: dt = CFL number * h / (c_el + max |v_p|); fixed: dt = Fixed time step.");
     prm.declare_entry("CFL number", "0.5", Patterns::Double(0, 1),
@@ -630,6 +634,7 @@ namespace mpm
     shape_function = shape == "GIMP"               ? ShapeFunction::gimp :
                      shape == "quadratic B-spline" ? ShapeFunction::bspline2 :
                      shape == "cubic B-spline"     ? ShapeFunction::bspline3 :
+                     shape == "cubic B-spline GIMP" ? ShapeFunction::bspline3_gimp :
                      shape == "CPDI"               ? ShapeFunction::cpdi :
                      shape == "CPDI2q"             ? ShapeFunction::cpdi2q : ShapeFunction::linear;
     const bool cpdi_family = shape_function == ShapeFunction::cpdi || shape_function == ShapeFunction::cpdi2q;
@@ -640,12 +645,17 @@ namespace mpm
     domain_update = du == "det F" ? DomainUpdate::det_F :
                     du == "F_ii"  ? DomainUpdate::stretch :
                     du == "U"     ? DomainUpdate::U : DomainUpdate::none;
-    if (shape_function != ShapeFunction::gimp && domain_update != DomainUpdate::none)
-      fail("Solver/GIMP domain update", "'" + du + "' needs Shape function = GIMP; with Shape function = " + shape +
-                                        " the only allowed value is none.");
+    if (shape_function != ShapeFunction::gimp && shape_function != ShapeFunction::bspline3_gimp &&
+        domain_update != DomainUpdate::none)
+      fail("Solver/GIMP domain update", "'" + du + "' needs Shape function = GIMP or cubic B-spline GIMP; with "
+                                        "Shape function = " + shape + " the only allowed value is none.");
     if (cpdi_family && active_block_cells > 0)
       fail("Grid/Nodes", "'near material' keeps the nodes within a fixed number of cells of each point's cell, "
                          "but a CPDI domain stretched by the flow reaches farther; with Shape function = " + shape +
+                         " the only allowed value is all.");
+    if (shape_function == ShapeFunction::bspline3_gimp && active_block_cells > 0)
+      fail("Grid/Nodes", "'near material' keeps the nodes within one cell of the points' cells, but the cubic "
+                         "B-spline GIMP's stencil reaches two cells out; with Shape function = " + shape +
                          " the only allowed value is all.");
     adaptive_time_step = prm.get("Time step") == "adaptive";
     cfl                = prm.get_double("CFL number");
@@ -665,7 +675,8 @@ namespace mpm
     const std::string transfer = prm.get("Velocity transfer");
     apic                       = transfer == "APIC" || transfer == "TPIC";
     affine_matrix = transfer == "APIC" ? AffineMatrix::b_d_inverse : AffineMatrix::velocity_gradient;
-    if (transfer == "APIC" && (shape_function == ShapeFunction::gimp || cpdi_family))
+    if (transfer == "APIC" &&
+        (shape_function == ShapeFunction::gimp || shape_function == ShapeFunction::bspline3_gimp || cpdi_family))
       fail("Solver/Velocity transfer", "APIC needs Shape function = linear, quadratic B-spline or cubic B-spline "
                                        "(its D_p is constant only for the B-splines; with GIMP or CPDI a D_p "
                                        "computed per point turns singular at the grid's faces); with Shape "

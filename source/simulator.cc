@@ -8,12 +8,15 @@ namespace mpm
   {
     check_memory(parameters, communicator); // before anything large is allocated
     // A rank holds the nodes of its cells and one ring of ghost cells; a CPDI domain
-    // stretched by the flow reaches beyond that ring, where its weights would be lost.
+    // stretched by the flow, and the cubic B-spline GIMP's stencil (two cells out of a
+    // point's cell), reach beyond that ring, where their weights would be lost.
     AssertThrow((parameters.shape_function != ShapeFunction::cpdi &&
-                 parameters.shape_function != ShapeFunction::cpdi2q) ||
+                 parameters.shape_function != ShapeFunction::cpdi2q &&
+                 parameters.shape_function != ShapeFunction::bspline3_gimp) ||
                   dealii::Utilities::MPI::n_mpi_processes(communicator) == 1,
-                dealii::ExcMessage("Parameter 'Solver/Shape function': CPDI and CPDI2q run on one MPI rank (their "
-                                   "domains reach beyond the ghost cells of a rank's part of the grid); run this "
+                dealii::ExcMessage("Parameter 'Solver/Shape function': cubic B-spline GIMP, CPDI and CPDI2q run on "
+                                   "one MPI rank (their stencils reach beyond the ghost cells of a rank's part of "
+                                   "the grid); run this "
                                    "scene on one rank, or with linear, GIMP, quadratic B-spline or cubic B-spline on " +
                                    std::to_string(dealii::Utilities::MPI::n_mpi_processes(communicator)) +
                                    " ranks."));

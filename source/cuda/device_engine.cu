@@ -1181,6 +1181,8 @@ namespace mpm
             first = impl->order.template sort<QuadraticBSplineShape>(impl->backend, g, impl->points, home, cells);
           else if (impl->shape == ShapeFunction::bspline3)
             first = impl->order.template sort<CubicBSplineShape>(impl->backend, g, impl->points, home, cells);
+          else if (impl->shape == ShapeFunction::bspline3_gimp)
+            first = impl->order.template sort<CubicBSplineGimpShape>(impl->backend, g, impl->points, home, cells);
           else
             first = impl->order.template sort<LinearShape>(impl->backend, g, impl->points, home, cells);
           impl->home_by_slot_stale    = true;

@@ -14,6 +14,7 @@ int main(int argc, char **argv)
       mpm_test::check_bspline_column<mpm::QuadraticBSplineShape, mpm_test::CpuTarget>("quadratic B-spline", levels,
                                                                                        false);
       mpm_test::check_bspline_column<mpm::CubicBSplineShape, mpm_test::CpuTarget>("cubic B-spline", levels, false);
+      mpm_test::check_bspline_gimp_column<mpm_test::CpuTarget>(levels, false);
     }
   else
     {
@@ -22,6 +23,7 @@ int main(int argc, char **argv)
                                                                                        {16, 32, 64}, true);
       mpm_test::check_bspline_column<mpm::CubicBSplineShape, mpm_test::CpuTarget>("cubic B-spline", {16, 32, 64},
                                                                                    true);
+      mpm_test::check_bspline_gimp_column<mpm_test::CpuTarget>({8, 16, 32, 64, 128, 256}, true);
     }
   return mpm_test::finish("test_elastic_column");
 }

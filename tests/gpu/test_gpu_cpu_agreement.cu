@@ -70,20 +70,28 @@ void column_agreement(const char *shape, const DomainUpdate update)
             spread, n, true);
 }
 
-// The spinning block on the given target: cpGIMP with the U domain update, or the cubic
-// B-spline.
-template <int dim, template <int, typename> class Target>
-void spin(const bool cubic, HostPoints<dim, double> &out, const HostPoints<dim, double> *start, const long steps)
+// The spinning block on the given target: cpGIMP with the U domain update, the cubic
+// B-spline, or the cubic B-spline GIMP with the U domain update.
+enum class Spun
 {
-  if (cubic)
+  gimp_u,
+  cubic,
+  cubic_gimp_u
+};
+template <int dim, template <int, typename> class Target>
+void spin(const Spun shape, HostPoints<dim, double> &out, const HostPoints<dim, double> *start, const long steps)
+{
+  if (shape == Spun::cubic)
     spinning_block<dim, CubicBSplineShape, Target>(DomainUpdate::none, out, M_PI / 2, steps, start);
+  else if (shape == Spun::cubic_gimp_u)
+    spinning_block<dim, CubicBSplineGimpShape, Target>(DomainUpdate::U, out, M_PI / 2, steps, start);
   else
     spinning_block<dim, GimpShape, Target>(DomainUpdate::U, out, M_PI / 2, steps, start);
 }
 
 // The spinning block, 300 steps (a third of the quarter turn).
 template <int dim>
-void spin_agreement(const bool cubic = false)
+void spin_agreement(const Spun cubic = Spun::gimp_u)
 {
   const long              n = 300;
   HostPoints<dim, double> cpu, gpu, initial;
@@ -91,8 +99,10 @@ void spin_agreement(const bool cubic = false)
   spin<dim, CpuTarget>(cubic, cpu, &initial, n);
   const Difference spread = cpu_reordering_spread(
     initial, cpu, 0.125, [&](auto &out, const auto *start) { spin<dim, CpuTarget>(cubic, out, start, n); });
-  const std::string scene =
-    std::string("spinning block ") + (cubic ? "cubic B-spline" : "U") + (dim == 2 ? " (2D)" : " (3D)");
+  const char *const name  = cubic == Spun::cubic        ? "cubic B-spline" :
+                            cubic == Spun::cubic_gimp_u ? "cubic B-spline GIMP U" :
+                                                          "U";
+  const std::string scene = std::string("spinning block ") + name + (dim == 2 ? " (2D)" : " (3D)");
   spin<dim, CudaTarget>(cubic, gpu, &initial, n);
   report<dim>(scene.c_str(), compare_points(cpu, gpu, 0.125), spread, n, false);
   spin<dim, CudaSortedTarget>(cubic, gpu, &initial, n);
@@ -117,7 +127,11 @@ int main()
       // The cubic B-spline: its fold at the column's base and sides, and in 3D its 64-node
       // stencil, which the device scatters point by point (too long for the staging area)
       column_agreement<CubicBSplineShape>("2D cubic B-spline", DomainUpdate::none);
-      spin_agreement<3>(true);
+      spin_agreement<3>(Spun::cubic);
+      // The cubic B-spline GIMP (five nodes per direction, the domains following F_ii or U):
+      // 2D through the staging area, 3D (125 nodes) point by point
+      column_agreement<CubicBSplineGimpShape>("2D cubic B-spline GIMP", DomainUpdate::stretch);
+      spin_agreement<3>(Spun::cubic_gimp_u);
       {
         // V3 geometry, elastic, the equilibration's steps (points held, the grid keeping its
         // velocities, damping 0.8) from zero stress. The damped path follows round-off (the

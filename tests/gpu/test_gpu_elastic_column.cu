@@ -14,6 +14,7 @@ int main()
                                                                                         {16, 32, 64}, true);
       mpm_test::check_bspline_column<mpm::CubicBSplineShape, mpm_test::CudaTarget>("cubic B-spline", {16, 32, 64},
                                                                                     true);
+      mpm_test::check_bspline_gimp_column<mpm_test::CudaTarget>({8, 16, 32, 64, 128, 256}, true);
     }
   catch (const std::exception &e)
     {

@@ -19,7 +19,11 @@ namespace mpm
     // GIMP and the quadratic B-spline: stencil first node floor(s + 1/2) - 1, three nodes;
     // linear: floor(s), two; the cubic B-spline: floor(s) - 1, four, so the point must stay
     // in its home cell (the points are re-sorted as soon as one leaves it).
-    return shape == ShapeFunction::linear ? 1.0 : shape == ShapeFunction::bspline3 ? 0.0 : 0.5;
+    // The cubic B-spline GIMP reaches two cells out even from inside its home cell, so no
+    // distance is safe: it runs on one rank with every node (Parameters refuses the rest).
+    return shape == ShapeFunction::linear                                                   ? 1.0 :
+           shape == ShapeFunction::bspline3 || shape == ShapeFunction::bspline3_gimp ? 0.0 :
+                                                                                            0.5;
   }
 
   // Distance of point i outside its home cell (0 inside), in cell units, max-norm.

@@ -20,7 +20,8 @@ namespace mpm
     bspline2 = 2, // quadratic B-spline, its ghost node at a lattice face folded into the face's nodes
     bspline3 = 3, // cubic B-spline, the same fold
     cpdi     = 4, // CPDI: linear hats averaged over a parallelogram / parallelepiped domain following F (cpdi.h)
-    cpdi2q   = 5  // CPDI2q (2D): the same over a quadrilateral whose corners move with the grid (cpdi.h)
+    cpdi2q   = 5, // CPDI2q (2D): the same over a quadrilateral whose corners move with the grid (cpdi.h)
+    bspline3_gimp = 6 // the cubic B-spline averaged over each point's domain (cubic_bspline_gimp.h)
   };
 
   // Standard MPM: the two nodes of the cell containing s.
@@ -191,9 +192,30 @@ namespace mpm
         // The stencil starts at most one node below the lattice (node -1) and ends at most
         // one above (node n_cells + 1; the cubic's n_cells + 2 only for a point exactly on
         // the face, with weight 0), two nodes away from the stencil's far end.
-        static_assert(n == 3 || n == 4, "the fold is written for three or four nodes per direction");
+        // The cubic averaged over a domain (five nodes, cubic_bspline_gimp.h) reaches one more
+        // ghost on each side where its domain crosses the face: u = 3 u_face - 2 u_inner there.
+        static_assert(n >= 3 && n <= 5, "the fold is written for three to five nodes per direction");
         for (int k = 0; k < n; ++k)
           {
+            if constexpr (n == 5)
+              {
+                if (first + k == -2) // the second ghost below face 0
+                  {
+                    w[k + 2] += Real(3) * w[k];
+                    w[k + 3] -= Real(2) * w[k];
+                    dw[k + 2] += Real(3) * dw[k];
+                    dw[k + 3] -= Real(2) * dw[k];
+                    w[k] = dw[k] = Real(0);
+                  }
+                if (first + k == n_cells + 2) // the second ghost above face n_cells
+                  {
+                    w[k - 2] += Real(3) * w[k];
+                    w[k - 3] -= Real(2) * w[k];
+                    dw[k - 2] += Real(3) * dw[k];
+                    dw[k - 3] -= Real(2) * dw[k];
+                    w[k] = dw[k] = Real(0);
+                  }
+              }
             if (first + k == -1 && k + 2 < n) // the ghost below face 0
               {
                 w[k + 1] += Real(2) * w[k];

@@ -8,6 +8,7 @@
 // algorithm (doc/theory.md).
 #pragma once
 
+#include <mpm/core/cubic_bspline_gimp.h>
 #include <mpm/core/domain_update.h>
 #include <mpm/core/interpolation.h>
 #include <mpm/core/local_damping.h>
@@ -1401,6 +1402,9 @@ namespace mpm
       return explicit_step<dim, QuadraticBSplineShape, physics>(backend, g, p, materials, s, dt, exchange, averaging_pending);
     if (shape == ShapeFunction::bspline3)
       return explicit_step<dim, CubicBSplineShape, physics>(backend, g, p, materials, s, dt, exchange, averaging_pending);
+    if (shape == ShapeFunction::bspline3_gimp)
+      return explicit_step<dim, CubicBSplineGimpShape, physics>(backend, g, p, materials, s, dt, exchange,
+                                                                averaging_pending);
     if (shape == ShapeFunction::cpdi)
       return explicit_step<dim, CpdiShape, physics>(backend, g, p, materials, s, dt, exchange, averaging_pending);
     if (shape == ShapeFunction::cpdi2q)

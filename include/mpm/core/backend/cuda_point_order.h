@@ -171,15 +171,7 @@ namespace mpm
       if (host.n_state_variables() < points.n_state_variables())
         host.set_n_state_variables(points.n_state_variables());
       for_each_point_array<dim>(points, host, [&](const auto &device, auto &out) {
-        auto &scratch = scratch_for(device);
-        scratch.resize(n);
-        if (n > 0)
-          {
-            const int threads = 256;
-            cuda_detail::scatter_kernel<<<(n + threads - 1) / threads, threads, 0, backend.get_stream()>>>(
-              n, original.data(), device.data(), scratch.data());
-            MPM_CUDA_CHECK_LAUNCH();
-          }
+        auto &scratch = queue_in_reference_order(backend, device, n);
         backend.synchronize();
         scratch.download(out);
       });
@@ -201,12 +193,7 @@ namespace mpm
         return;
       long k_real = 0, k_int = 0;
       for_each_point_array<dim>(points, points, [&](const auto &device, const auto &) {
-        auto &scratch = scratch_for(device);
-        scratch.resize(n); // where it grows, cudaFree waits for the copies queued before
-        const int threads = 256;
-        cuda_detail::scatter_kernel<<<(n + threads - 1) / threads, threads, 0, backend.get_stream()>>>(
-          n, original.data(), device.data(), scratch.data());
-        MPM_CUDA_CHECK_LAUNCH();
+        auto &scratch = queue_in_reference_order(backend, device, n);
         using T = typename std::decay_t<decltype(device)>::value_type;
         T *to   = nullptr;
         if constexpr (std::is_same<T, int>::value)
@@ -279,6 +266,24 @@ namespace mpm
           for (int slot = 0; slot < group.count; ++slot)
             arrays[slots[slot]]->swap(scratch[slot]);
         }
+    }
+
+    // One point array put back in the reference order, into the scratch array of its type,
+    // queued on the backend's stream. Where the scratch array grows, cudaFree waits for the
+    // copies queued before.
+    template <typename T>
+    DeviceArray<T> &queue_in_reference_order(CudaBackend &backend, const DeviceArray<T> &device, const int n)
+    {
+      DeviceArray<T> &scratch = scratch_for(device);
+      scratch.resize(n);
+      if (n > 0)
+        {
+          const int threads = 256;
+          cuda_detail::scatter_kernel<<<(n + threads - 1) / threads, threads, 0, backend.get_stream()>>>(
+            n, original.data(), device.data(), scratch.data());
+          MPM_CUDA_CHECK_LAUNCH();
+        }
+      return scratch;
     }
 
     DeviceArray<Real> &scratch_for(const DeviceArray<Real> &) { return real_scratch; }

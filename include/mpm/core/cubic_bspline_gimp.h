@@ -1,0 +1,80 @@
+// The cubic B-spline averaged over a point's domain [s - lp, s + lp] (cell units), as
+// GIMP averages the linear hat: w_i = (M(r + lp) - M(r - lp)) / (2 lp) with M the
+// antiderivative of the B-spline and r = s - x_i. Where the domains follow the
+// deformation and tile the body (cpGIMP's domain update), a stress that is constant per
+// domain is integrated exactly, so the quadrature error that stalls the plain B-spline
+// on V1's compressed column goes away (doc/methods.md, "V1 column").
+#pragma once
+
+#include <mpm/core/shape_functions.h>
+
+namespace mpm
+{
+  // The cubic B-spline and its antiderivative from -2 (M(-2) = 0, M(0) = 1/2, M(2) = 1).
+  template <typename Real>
+  MPM_HOST_DEVICE inline Real cubic_bspline(const Real r)
+  {
+    const Real a = r < Real(0) ? -r : r;
+    if (a < Real(1))
+      return Real(2) / Real(3) - a * a + Real(0.5) * a * a * a;
+    if (a < Real(2))
+      return (Real(2) - a) * (Real(2) - a) * (Real(2) - a) / Real(6);
+    return Real(0);
+  }
+
+  template <typename Real>
+  MPM_HOST_DEVICE inline Real cubic_bspline_integral(const Real r)
+  {
+    // Odd about r = 0 up to the constant 1/2: M(r) = 1/2 + sign(r) P(|r|).
+    const Real a = r < Real(0) ? -r : r;
+    Real       p; // integral of the B-spline from 0 to a
+    if (a < Real(1))
+      p = Real(2) / Real(3) * a - a * a * a / Real(3) + a * a * a * a / Real(8);
+    else if (a < Real(2))
+      {
+        const Real b = Real(2) - a;
+        p            = Real(0.5) - b * b * b * b / Real(24);
+      }
+    else
+      p = Real(0.5);
+    return r < Real(0) ? Real(0.5) - p : Real(0.5) + p;
+  }
+
+  // Support 2 + lp on each side (lp < 1/2): five nodes from floor(s - lp) - 1. Near a
+  // lattice face the ghost nodes fold as for the plain cubic (fold_boundary).
+  struct CubicBSplineGimpShape
+  {
+    static constexpr bool tensor_product  = true;
+    static constexpr bool tracks_corners  = false;
+    static constexpr int  n_per_direction = 5;
+    static constexpr bool folds_boundary  = true;
+
+    template <typename Real>
+    MPM_HOST_DEVICE static void weights_1d(const Real s, const Real lp, int &first, Real w[5], Real dw[5])
+    {
+      first = static_cast<int>(std::floor(s - lp)) - 1;
+      // Below 1e-4 cells the average differs from the point value by about lp^2 / 6, far
+      // below round-off of the difference quotient's cancellation.
+      const bool point_value = !(lp > Real(1e-4));
+      for (int k = 0; k < 5; ++k)
+        {
+          const Real r = s - Real(first + k); // point minus node: d/dx_point = d/dr
+          if (point_value)
+            {
+              const Real a    = r < Real(0) ? -r : r;
+              const Real sign = r < Real(0) ? Real(-1) : Real(1);
+              w[k]            = cubic_bspline(r);
+              dw[k] = a < Real(1) ? sign * (Real(-2) * a + Real(1.5) * a * a) :
+                      a < Real(2) ? -sign * Real(0.5) * (Real(2) - a) * (Real(2) - a) :
+                                    Real(0);
+            }
+          else
+            {
+              const Real inverse_length = Real(0.5) / lp;
+              w[k]  = (cubic_bspline_integral(r + lp) - cubic_bspline_integral(r - lp)) * inverse_length;
+              dw[k] = (cubic_bspline(r + lp) - cubic_bspline(r - lp)) * inverse_length;
+            }
+        }
+    }
+  };
+} // namespace mpm
