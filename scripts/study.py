@@ -77,6 +77,8 @@ METHODS = {
                         ["@material", "  set Elastic law = Hencky", "end"]),
     "cpdi": ("CPDI, FLIP 0.99", shape("CPDI") + ["set FLIP fraction = 0.99"], []),
     "cpdi2q": ("CPDI2q, FLIP 0.99", shape("CPDI2q") + ["set FLIP fraction = 0.99"], []),
+    "bspline3_gimp_f_ii": ("B-spline 3 GIMP F_ii, FLIP 0.99",
+                           shape("cubic B-spline GIMP", "F_ii") + ["set FLIP fraction = 0.99"], []),
 }
 
 

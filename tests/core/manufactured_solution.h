@@ -114,7 +114,8 @@ namespace mpm_test
     quadratic_bspline,
     cubic_bspline,
     cpdi,
-    cpdi2q
+    cpdi2q,
+    cubic_bspline_gimp
   };
   struct MmsMethod
   {
@@ -147,7 +148,8 @@ namespace mpm_test
              mpm::AffineMatrix::b_d_inverse},
             {"cpgimp_u_hencky", MmsShape::gimp, DomainUpdate::U, 0.99, false, mpm::ElasticLaw::hencky},
             {"cpdi", MmsShape::cpdi},
-            {"cpdi2q", MmsShape::cpdi2q}};
+            {"cpdi2q", MmsShape::cpdi2q},
+            {"bspline3_gimp_f_ii", MmsShape::cubic_bspline_gimp, DomainUpdate::stretch}};
   }
 
   inline MmsMethod mms_method(const std::string &key)
@@ -318,6 +320,9 @@ namespace mpm_test
           return run_manufactured_solution_with<mpm::CpdiShape, Real>(motion, method, n_cells, cfl, periods);
         case MmsShape::cpdi2q:
           return run_manufactured_solution_with<mpm::Cpdi2qShape, Real>(motion, method, n_cells, cfl, periods);
+        case MmsShape::cubic_bspline_gimp:
+          return run_manufactured_solution_with<mpm::CubicBSplineGimpShape, Real>(motion, method, n_cells, cfl,
+                                                                                periods);
       }
     throw std::logic_error("run_manufactured_solution: unknown shape");
   }
