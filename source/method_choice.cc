@@ -29,7 +29,8 @@ namespace mpm
     const std::vector<MethodSettings> &methods()
     {
       const auto g = ShapeFunction::gimp, b2 = ShapeFunction::bspline2, b3 = ShapeFunction::bspline3,
-                 lin = ShapeFunction::linear, cpdi = ShapeFunction::cpdi, cpdi2q = ShapeFunction::cpdi2q;
+                 lin = ShapeFunction::linear, cpdi = ShapeFunction::cpdi, cpdi2q = ShapeFunction::cpdi2q,
+                 b3_gimp = ShapeFunction::bspline3_gimp;
       const auto none = DomainUpdate::none, det_f = DomainUpdate::det_F, f_ii = DomainUpdate::stretch,
                  u = DomainUpdate::U;
       const auto tpic = AffineMatrix::velocity_gradient, apic = AffineMatrix::b_d_inverse;
@@ -50,6 +51,7 @@ namespace mpm
         {"cpgimp_u_hencky", "cpGIMP U, FLIP 0.99, Hencky", g, u, false, tpic, 0.99, true},
         {"cpdi", "CPDI, FLIP 0.99", cpdi, none, false, tpic, 0.99, false},
         {"cpdi2q", "CPDI2q, FLIP 0.99", cpdi2q, none, false, tpic, 0.99, false},
+        {"bspline3_gimp_f_ii", "cubic B-spline GIMP F_ii, FLIP 0.99", b3_gimp, f_ii, false, tpic, 0.99, false},
       };
       return all;
     }
@@ -161,7 +163,9 @@ namespace mpm
             left_out << "\n    " << m.label << ": Hencky needs built-in models only";
             continue;
           }
-        if ((m.shape == ShapeFunction::cpdi || m.shape == ShapeFunction::cpdi2q) && !cpdi_allowed)
+        if ((m.shape == ShapeFunction::cpdi || m.shape == ShapeFunction::cpdi2q ||
+             m.shape == ShapeFunction::bspline3_gimp) &&
+            !cpdi_allowed)
           {
             left_out << "\n    " << m.label << ": runs on one MPI rank with Grid/Nodes = all";
             continue;

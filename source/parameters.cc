@@ -654,9 +654,9 @@ namespace mpm
                          "but a CPDI domain stretched by the flow reaches farther; with Shape function = " + shape +
                          " the only allowed value is all.");
     if (shape_function == ShapeFunction::bspline3_gimp && active_block_cells > 0)
-      fail("Grid/Nodes", "'near material' keeps the nodes within one cell of the points' cells, but the cubic "
-                         "B-spline GIMP's stencil reaches two cells out; with Shape function = " + shape +
-                         " the only allowed value is all.");
+      fail("Grid/Nodes", "'near material' keeps the nodes that a point's stencil reaches while it stays near its "
+                         "cell, but the cubic B-spline GIMP's stencil reaches two cells out of it at once; with "
+                         "Shape function = " + shape + " the only allowed value is all.");
     adaptive_time_step = prm.get("Time step") == "adaptive";
     cfl                = prm.get_double("CFL number");
     if (!(cfl > 0))

@@ -49,7 +49,8 @@ namespace mpm
   // Costs within 10% count as equal (the study's timings are single runs), and the more accurate of
   // those wins. In 3D pure FLIP is left out (it broke down on P2, the 3D collapse; the study's scenes
   // are 2D). Throws std::invalid_argument, saying what the best method would give, where none reaches
-  // the tolerance. CPDI only where cpdi_allowed (one MPI rank, Grid/Nodes = all).
+  // the tolerance. CPDI, CPDI2q and the cubic B-spline GIMP only where cpdi_allowed
+  // (one MPI rank, Grid/Nodes = all).
   MethodChoice choose_method(const std::string &scene, double cells, double tolerance, bool cuda,
                              bool hencky_allowed, unsigned int dim, bool cpdi_allowed = true);
 } // namespace mpm
