@@ -49,6 +49,8 @@ METHODS = {
                         ["@material", "  set Elastic law = Hencky", "end"]),
     "cpdi": ("CPDI", ["set Shape function = CPDI", "set GIMP domain update = none"]),
     "cpdi2q": ("CPDI2q", ["set Shape function = CPDI2q", "set GIMP domain update = none"]),
+    "bspline3_gimp_f_ii": ("cubic B-spline GIMP F_ii", ["set Shape function = cubic B-spline GIMP",
+                                                        "set GIMP domain update = F_ii"]),
 }
 
 
