@@ -1,6 +1,7 @@
 // Partition of unity, linear fields reproduced (weights and gradients), and gradients equal
 // to the derivative of the weights (finite differences), for the linear, GIMP, quadratic and
-// cubic B-spline stencils and the cubic B-spline GIMP at random points, 2D and 3D. The B-splines are checked over the
+// cubic B-spline stencils and the cubic B-spline GIMP at random points, 2D and 3D. The B-splines are checked
+// over the
 // whole grid, their folded boundary cells included (GIMP's domains inside the grid).
 #include <mpm/core/cubic_bspline_gimp.h>
 #include <mpm/core/host_storage.h>
@@ -120,9 +121,10 @@ int main()
   check_family<2, CubicBSplineShape>("cubic B-spline", rng, true);
   check_family<3, CubicBSplineShape>("cubic B-spline", rng, true);
   // Domains inside the grid, as GIMP's (where a domain crosses a face the folds give weights
-  // down to about -2e-5). Its weights are differences of the B-spline's antiderivative over
-  // 2 lp, down to 0.02 cells here: 25-125 of them lose up to about 25 u / 0.02 = 3e-13 of
-  // the sum; measured 1.4e-14.
+  // down to about -2e-5). Its 1D weights are differences of the B-spline's antiderivative
+  // divided by 2 lp, lp down to 0.01 cells here: each loses up to about u / (2 lp) = 1e-14
+  // (u = 2.2e-16), the five of a direction up to 5e-14, and the tensor product's sum about
+  // as much per direction: the bound 1e-13; measured 1.4e-14.
   check_family<2, CubicBSplineGimpShape>("cubic B-spline GIMP", rng, false, 1e-13);
   check_family<3, CubicBSplineGimpShape>("cubic B-spline GIMP", rng, false, 1e-13);
 
@@ -179,7 +181,8 @@ int main()
                         1e-15, "cubic B-spline folded at the upper face");
 
   // The cubic B-spline GIMP: the cubic's mean over [s - lp, s + lp] (midpoint rule with 20,000
-  // intervals, error ~1e-10) at interior points, and the cubic itself as lp -> 0.
+  // intervals, error ~1e-10) at interior points, and below lp = 1e-4 cells (where the shape
+  // takes the point value instead of the difference quotient) the cubic itself.
   double w_a[5], dw_a[5];
   int    f_a;
   for (const double lp : {0.05, 0.25, 0.49})

@@ -40,8 +40,11 @@ namespace mpm
     return r < Real(0) ? Real(0.5) - p : Real(0.5) + p;
   }
 
-  // Support 2 + lp on each side (lp < 1/2): five nodes from floor(s - lp) - 1. Near a
-  // lattice face the ghost nodes fold as for the plain cubic (fold_boundary).
+  // Support 2 + lp on each side (lp < 1/2): five nodes from floor(s - lp) - 1. As the other
+  // shapes' weights_1d: s is the point's coordinate and lp its domain's half-length, both in
+  // cell units; it gives the first node's lattice index and the five nodes' weights w and
+  // derivatives dw = dw/ds (multiply by 1/h for d/dx). Near a lattice face the ghost nodes
+  // fold as for the plain cubic (fold_boundary, applied by stencil_weights_1d).
   struct CubicBSplineGimpShape
   {
     static constexpr bool tensor_product  = true;
