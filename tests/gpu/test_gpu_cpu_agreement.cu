@@ -91,21 +91,21 @@ void spin(const Spun shape, HostPoints<dim, double> &out, const HostPoints<dim, 
 
 // The spinning block, 300 steps (a third of the quarter turn).
 template <int dim>
-void spin_agreement(const Spun cubic = Spun::gimp_u)
+void spin_agreement(const Spun shape = Spun::gimp_u)
 {
   const long              n = 300;
   HostPoints<dim, double> cpu, gpu, initial;
-  spin<dim, CpuTarget>(cubic, initial, nullptr, 0);
-  spin<dim, CpuTarget>(cubic, cpu, &initial, n);
+  spin<dim, CpuTarget>(shape, initial, nullptr, 0);
+  spin<dim, CpuTarget>(shape, cpu, &initial, n);
   const Difference spread = cpu_reordering_spread(
-    initial, cpu, 0.125, [&](auto &out, const auto *start) { spin<dim, CpuTarget>(cubic, out, start, n); });
-  const char *const name  = cubic == Spun::cubic        ? "cubic B-spline" :
-                            cubic == Spun::cubic_gimp_u ? "cubic B-spline GIMP U" :
+    initial, cpu, 0.125, [&](auto &out, const auto *start) { spin<dim, CpuTarget>(shape, out, start, n); });
+  const char *const name  = shape == Spun::cubic        ? "cubic B-spline" :
+                            shape == Spun::cubic_gimp_u ? "cubic B-spline GIMP U" :
                                                           "U";
   const std::string scene = std::string("spinning block ") + name + (dim == 2 ? " (2D)" : " (3D)");
-  spin<dim, CudaTarget>(cubic, gpu, &initial, n);
+  spin<dim, CudaTarget>(shape, gpu, &initial, n);
   report<dim>(scene.c_str(), compare_points(cpu, gpu, 0.125), spread, n, false);
-  spin<dim, CudaSortedTarget>(cubic, gpu, &initial, n);
+  spin<dim, CudaSortedTarget>(shape, gpu, &initial, n);
   report<dim>((scene + ", GPU sorted every 7").c_str(), compare_points(cpu, gpu, 0.125), spread, n, false);
 }
 
