@@ -134,7 +134,8 @@ namespace mpm
   }
 
   MethodChoice choose_method(const std::string &scene, const double cells, const double tolerance, const bool cuda,
-                             const bool hencky_allowed, const unsigned int dim, const bool cpdi_allowed)
+                             const bool hencky_allowed, const unsigned int dim, const bool cpdi_allowed,
+                             const bool bspline3_gimp_allowed)
   {
     if (!(cells > 0) || !(tolerance > 0))
       throw std::invalid_argument("choose_method: cells and tolerance must be > 0");
@@ -163,11 +164,15 @@ namespace mpm
             left_out << "\n    " << m.label << ": Hencky needs built-in models only";
             continue;
           }
-        if ((m.shape == ShapeFunction::cpdi || m.shape == ShapeFunction::cpdi2q ||
-             m.shape == ShapeFunction::bspline3_gimp) &&
-            !cpdi_allowed)
+        if ((m.shape == ShapeFunction::cpdi || m.shape == ShapeFunction::cpdi2q) && !cpdi_allowed)
           {
             left_out << "\n    " << m.label << ": runs on one MPI rank with Grid/Nodes = all";
+            continue;
+          }
+        if (m.shape == ShapeFunction::bspline3_gimp && !bspline3_gimp_allowed)
+          {
+            left_out << "\n    " << m.label << ": runs on one MPI rank, with Grid/Nodes = all, or near material "
+                     << "on the CPU with Active block size >= 2";
             continue;
           }
         if (dim == 3 && m.shape == ShapeFunction::cpdi2q)

@@ -2,7 +2,8 @@
 // of the block, for block sizes 1-5, in 2D and 3D:
 // - enough: a point anywhere within active_node_margin cells (max-norm) of the cell it was
 //   in finds every node of its stencil active, for each shape function (GIMP at the largest
-//   half-length, 1/2), the B-splines' folded ghost nodes included;
+//   half-length, 1/2; the cubic B-spline GIMP at 1/2 and down to 1e-5), the B-splines'
+//   folded ghost nodes included; and a margin 0.1 cell too large finds one missing;
 // - not more than the blocks promise: every active node lies in a node block holding a
 //   vertex of a cell of a live point's block or its neighbours (2B - 1 cells below the
 //   point's cell to 3B - 1 above);
@@ -11,6 +12,7 @@
 // - a chooser that chose before gives the same table as a new one (its old entries reset),
 //   and keeps exactly the holding blocks and their neighbours.
 #include <mpm/core/active_nodes.h>
+#include <mpm/core/cubic_bspline_gimp.h>
 
 #include "check.h"
 
@@ -25,13 +27,15 @@ namespace
 {
   using mpm_test::check;
 
+  // lp: the domain's half-length in cells (GIMP and the cubic B-spline GIMP; the others ignore it).
   template <typename Shape, typename NodeOfLattice>
-  bool stencil_active(const double s_all[], const int dim, const int n_cells[], const NodeOfLattice &node_of)
+  bool stencil_active(const double s_all[], const int dim, const int n_cells[], const NodeOfLattice &node_of,
+                      const double lp = 0.5)
   {
     int    first[3], n = Shape::n_per_direction;
-    double w[3][4], dw[4];
+    double w[3][5], dw[5];
     for (int d = 0; d < dim; ++d)
-      Shape::weights_1d(s_all[d], 0.5, first[d], w[d], dw);
+      Shape::weights_1d(s_all[d], lp, first[d], w[d], dw);
     int total = 1;
     for (int d = 0; d < dim; ++d)
       total *= n;
@@ -166,10 +170,13 @@ namespace
     // Enough: points anywhere within the margin of their cell, each shape (the extremes of
     // the interval included), clamped into the lattice as points that stay in the grid are.
     const mpm::ShapeFunction shapes[] = {mpm::ShapeFunction::linear, mpm::ShapeFunction::gimp,
-                                         mpm::ShapeFunction::bspline2, mpm::ShapeFunction::bspline3};
+                                         mpm::ShapeFunction::bspline2, mpm::ShapeFunction::bspline3,
+                                         mpm::ShapeFunction::bspline3_gimp};
     for (const mpm::ShapeFunction shape : shapes)
       {
         const double margin = mpm::active_node_margin(shape, block);
+        if (margin < 0) // the cubic B-spline GIMP with blocks of 1 cell: refused (Grid/Active block size)
+          continue;
         bool         all    = true;
         for (const auto &c : live_cells)
           for (int trial = 0; trial < 40; ++trial)
@@ -187,8 +194,11 @@ namespace
                 all = all && stencil_active<mpm::GimpShape>(s, dim, n_cells, node_of);
               else if (shape == mpm::ShapeFunction::bspline2)
                 all = all && stencil_active<mpm::QuadraticBSplineShape>(s, dim, n_cells, node_of);
-              else
+              else if (shape == mpm::ShapeFunction::bspline3)
                 all = all && stencil_active<mpm::CubicBSplineShape>(s, dim, n_cells, node_of);
+              else // its stencil reaches farthest below at lp = 1/2, above at lp -> 0
+                for (const double lp : {0.5, 0.25, 1e-3, 1e-5})
+                  all = all && stencil_active<mpm::CubicBSplineGimpShape>(s, dim, n_cells, node_of, lp);
             }
         check(all, ("every stencil node active within the margin (shape " + std::to_string(int(shape)) + "), " +
                     where).c_str());
@@ -236,6 +246,64 @@ namespace
     }
     std::printf("%s: %ld of %ld nodes active\n", where.c_str(), n_active, n_lattice_nodes);
   }
+
+  // Not more than needed: a lone point in a cell at the end of its block (the fewest cells
+  // kept beyond it on that side), placed 0.1 cell beyond the margin along one axis below or
+  // above, finds a node of its stencil with a non-zero weight missing, for each shape at
+  // some half-length. So the margin is tight to 0.1 cell on at least one side.
+  template <int dim>
+  void check_margin_tight(const int block)
+  {
+    const int    n_cells[3] = {48, 48, 48};
+    const double origin[3]  = {0, 0, 0};
+    const double h          = 1;
+    const mpm::ShapeFunction shapes[] = {mpm::ShapeFunction::linear, mpm::ShapeFunction::gimp,
+                                         mpm::ShapeFunction::bspline2, mpm::ShapeFunction::bspline3,
+                                         mpm::ShapeFunction::bspline3_gimp};
+    for (const mpm::ShapeFunction shape : shapes)
+      {
+        const double margin = mpm::active_node_margin(shape, block);
+        if (margin < 0)
+          continue;
+        bool missing = false;
+        for (const bool above : {false, true})
+          {
+            // The cell: the last of its block above, the first below; far from the faces.
+            const int           c = above ? 4 * block - 1 : 4 * block;
+            std::vector<double> position[dim];
+            std::vector<int>    material{0};
+            for (int d = 0; d < dim; ++d)
+              position[d].push_back(c + 0.5);
+            mpm::PointsView<dim, double> p{};
+            p.n_points = 1;
+            for (int d = 0; d < dim; ++d)
+              p.position[d] = position[d].data();
+            p.material = material.data();
+            const mpm::NodeBlocks<dim> nodes = mpm::nodes_near_points<dim>(origin, h, n_cells, block, p, nullptr);
+            mpm::GridView<dim, double> view{};
+            for (int d = 0; d < dim; ++d)
+              view.n_cells[d] = n_cells[d];
+            view.set_block_table(nodes.block_slot.data(), nodes.block_cells, nodes.node_blocks);
+            auto   node_of = [&](const long lattice) { return view.node_of_lattice(lattice); };
+            double s[3]    = {c + 0.5, c + 0.5, c + 0.5};
+            s[0]           = above ? c + 1 + margin + 0.1 : c - margin - 0.1;
+            for (const double lp : {0.5, 0.25, 1e-3})
+              missing = missing ||
+                        !(shape == mpm::ShapeFunction::linear ?
+                            stencil_active<mpm::LinearShape>(s, dim, n_cells, node_of, lp) :
+                          shape == mpm::ShapeFunction::gimp ?
+                            stencil_active<mpm::GimpShape>(s, dim, n_cells, node_of, lp) :
+                          shape == mpm::ShapeFunction::bspline2 ?
+                            stencil_active<mpm::QuadraticBSplineShape>(s, dim, n_cells, node_of, lp) :
+                          shape == mpm::ShapeFunction::bspline3 ?
+                            stencil_active<mpm::CubicBSplineShape>(s, dim, n_cells, node_of, lp) :
+                            stencil_active<mpm::CubicBSplineGimpShape>(s, dim, n_cells, node_of, lp));
+          }
+        check(missing, ("a node missing 0.1 cell beyond the margin (shape " + std::to_string(int(shape)) + "), " +
+                        std::to_string(dim) + "D, blocks of " + std::to_string(block))
+                         .c_str());
+      }
+  }
 } // namespace
 
 int main()
@@ -245,6 +313,8 @@ int main()
     {
       check_lattice<2>(block, random);
       check_lattice<3>(block, random);
+      check_margin_tight<2>(block);
+      check_margin_tight<3>(block);
     }
   return mpm_test::failures() == 0 ? 0 : 1;
 }

@@ -19,11 +19,14 @@ namespace mpm
     // GIMP and the quadratic B-spline: stencil first node floor(s + 1/2) - 1, three nodes;
     // linear: floor(s), two; the cubic B-spline: floor(s) - 1, four, so the point must stay
     // in its home cell (the points are re-sorted as soon as one leaves it).
-    // The cubic B-spline GIMP reaches two cells out even from inside its home cell, so no
-    // distance is safe: it runs on one rank with every node (Parameters refuses the rest).
-    return shape == ShapeFunction::linear                                                   ? 1.0 :
-           shape == ShapeFunction::bspline3 || shape == ShapeFunction::bspline3_gimp ? 0.0 :
-                                                                                            0.5;
+    // The cubic B-spline GIMP weighs the nodes within 2 + lp of the point (lp <= 1/2): from
+    // home cell [c, c + 1] up to node c + 3 once s > c + 1/2, half a cell beyond the ring even
+    // from inside the cell, so its distance is negative. Several ranks refuse it; the nodes
+    // near the material keep further rings (active_node_margin).
+    return shape == ShapeFunction::linear        ? 1.0 :
+           shape == ShapeFunction::bspline3      ? 0.0 :
+           shape == ShapeFunction::bspline3_gimp ? -0.5 :
+                                                   0.5;
   }
 
   // Distance of point i outside its home cell (0 inside), in cell units, max-norm.

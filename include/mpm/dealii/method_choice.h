@@ -49,8 +49,10 @@ namespace mpm
   // Costs within 10% count as equal (the study's timings are single runs), and the more accurate of
   // those wins. In 3D pure FLIP is left out (it broke down on P2, the 3D collapse; the study's scenes
   // are 2D). Throws std::invalid_argument, saying what the best method would give, where none reaches
-  // the tolerance. CPDI, CPDI2q and the cubic B-spline GIMP only where cpdi_allowed
-  // (one MPI rank, Grid/Nodes = all).
+  // the tolerance. CPDI and CPDI2q only where cpdi_allowed (one MPI rank, Grid/Nodes = all),
+  // the cubic B-spline GIMP only where bspline3_gimp_allowed (one MPI rank; Grid/Nodes = all, or
+  // near material on the CPU with blocks of at least 2 cells).
   MethodChoice choose_method(const std::string &scene, double cells, double tolerance, bool cuda,
-                             bool hencky_allowed, unsigned int dim, bool cpdi_allowed = true);
+                             bool hencky_allowed, unsigned int dim, bool cpdi_allowed = true,
+                             bool bspline3_gimp_allowed = true);
 } // namespace mpm
