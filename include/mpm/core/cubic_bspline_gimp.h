@@ -10,16 +10,14 @@
 
 namespace mpm
 {
-  // The cubic B-spline and its antiderivative from -2 (M(-2) = 0, M(0) = 1/2, M(2) = 1).
+  // The cubic B-spline (shape_functions.h) and its antiderivative from -2 (M(-2) = 0,
+  // M(0) = 1/2, M(2) = 1).
   template <typename Real>
   MPM_HOST_DEVICE inline Real cubic_bspline(const Real r)
   {
-    const Real a = r < Real(0) ? -r : r;
-    if (a < Real(1))
-      return Real(2) / Real(3) - a * a + Real(0.5) * a * a * a;
-    if (a < Real(2))
-      return (Real(2) - a) * (Real(2) - a) * (Real(2) - a) / Real(6);
-    return Real(0);
+    Real w, slope;
+    cubic_bspline_and_slope(r, w, slope);
+    return w;
   }
 
   template <typename Real>
@@ -63,14 +61,7 @@ namespace mpm
         {
           const Real r = s - Real(first + k); // point minus node: d/dx_point = d/dr
           if (point_value)
-            {
-              const Real a    = r < Real(0) ? -r : r;
-              const Real sign = r < Real(0) ? Real(-1) : Real(1);
-              w[k]            = cubic_bspline(r);
-              dw[k] = a < Real(1) ? sign * (Real(-2) * a + Real(1.5) * a * a) :
-                      a < Real(2) ? -sign * Real(0.5) * (Real(2) - a) * (Real(2) - a) :
-                                    Real(0);
-            }
+            cubic_bspline_and_slope(r, w[k], dw[k]);
           else
             {
               const Real inverse_length = Real(0.5) / lp;

@@ -138,6 +138,31 @@ namespace mpm
   // Cubic B-spline (C2, support 4h) centred on each node: the two nodes of the point's cell
   // and one more on each side. Within one cell of a lattice face the stencil reaches a node
   // outside the lattice; fold_boundary (below) removes it.
+  // The cubic B-spline N(r) (support |r| < 2) and its slope dN/dr: the cubic B-spline's
+  // weights, and the cubic B-spline GIMP's (cubic_bspline_gimp.h) where its domain is a point.
+  template <typename Real>
+  MPM_HOST_DEVICE inline void cubic_bspline_and_slope(const Real r, Real &w, Real &dw)
+  {
+    const Real a    = r < Real(0) ? -r : r;
+    const Real sign = r < Real(0) ? Real(-1) : Real(1);
+    if (a < Real(1))
+      {
+        w  = Real(2) / Real(3) - a * a + Real(0.5) * a * a * a;
+        dw = sign * (Real(-2) * a + Real(1.5) * a * a);
+      }
+    else if (a < Real(2))
+      {
+        const Real b = Real(2) - a;
+        w            = b * b * b / Real(6);
+        dw           = -sign * Real(0.5) * b * b;
+      }
+    else
+      {
+        w  = Real(0);
+        dw = Real(0);
+      }
+  }
+
   struct CubicBSplineShape
   {
     static constexpr bool tensor_product  = true;
@@ -151,27 +176,7 @@ namespace mpm
     {
       first = static_cast<int>(std::floor(s)) - 1;
       for (int k = 0; k < 4; ++k)
-        {
-          const Real r    = s - Real(first + k); // point minus node: d/dx_point = d/dr
-          const Real a    = r < Real(0) ? -r : r;
-          const Real sign = r < Real(0) ? Real(-1) : Real(1);
-          if (a < Real(1))
-            {
-              w[k]  = Real(2) / Real(3) - a * a + Real(0.5) * a * a * a;
-              dw[k] = sign * (Real(-2) * a + Real(1.5) * a * a);
-            }
-          else if (a < Real(2))
-            {
-              const Real b = Real(2) - a;
-              w[k]         = b * b * b / Real(6);
-              dw[k]        = -sign * Real(0.5) * b * b;
-            }
-          else
-            {
-              w[k]  = Real(0);
-              dw[k] = Real(0);
-            }
-        }
+        cubic_bspline_and_slope(s - Real(first + k), w[k], dw[k]); // point minus node: d/dx_point = d/dr
     }
   };
 
