@@ -1,8 +1,7 @@
 // Partition of unity, linear fields reproduced (weights and gradients), and gradients equal
 // to the derivative of the weights (finite differences), for the linear, GIMP, quadratic and
-// cubic B-spline stencils and the cubic B-spline GIMP at random points, 2D and 3D. The B-splines are checked
-// over the
-// whole grid, their folded boundary cells included (GIMP's domains inside the grid).
+// cubic B-spline stencils and the cubic B-spline GIMP at random points, 2D and 3D. The B-splines are
+// checked over the whole grid, their folded boundary cells included (GIMP's domains inside the grid).
 #include <mpm/core/cubic_bspline_gimp.h>
 #include <mpm/core/host_storage.h>
 #include <mpm/core/interpolation.h>

@@ -135,9 +135,6 @@ namespace mpm
     }
   };
 
-  // Cubic B-spline (C2, support 4h) centred on each node: the two nodes of the point's cell
-  // and one more on each side. Within one cell of a lattice face the stencil reaches a node
-  // outside the lattice; fold_boundary (below) removes it.
   // The cubic B-spline N(r) (support |r| < 2) and its slope dN/dr: the cubic B-spline's
   // weights, and the cubic B-spline GIMP's (cubic_bspline_gimp.h) where its domain is a point.
   template <typename Real>
@@ -163,6 +160,9 @@ namespace mpm
       }
   }
 
+  // Cubic B-spline (C2, support 4h) centred on each node: the two nodes of the point's cell
+  // and one more on each side. Within one cell of a lattice face the stencil reaches a node
+  // outside the lattice; fold_boundary (below) removes it.
   struct CubicBSplineShape
   {
     static constexpr bool tensor_product  = true;
