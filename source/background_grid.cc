@@ -88,11 +88,17 @@ namespace mpm
   }
 
   unsigned int cell_partition_weight(const double n_points, const double point_weight,
-                                     const unsigned int n_lattice_cells)
+                                     const unsigned int n_lattice_cells, const bool empty_cells_cost)
   {
     constexpr double max_weight = std::numeric_limits<int>::max();
     const double     per_point  = std::min(std::round(16 * point_weight), max_weight);
-    return static_cast<unsigned int>(std::min(16.0 * n_lattice_cells + per_point * n_points, max_weight));
+    const double     per_cells  = empty_cells_cost || n_points > 0 ? 16.0 * n_lattice_cells : 0.0;
+    return static_cast<unsigned int>(std::min(per_cells + per_point * n_points, max_weight));
+  }
+
+  bool empty_cells_cost(const Parameters &parameters)
+  {
+    return !(parameters.active_block_cells > 0 && parameters.backend == "cpu");
   }
 
   template <int dim>
@@ -161,6 +167,7 @@ namespace mpm
               ++points_in_cell[lattice_cell_of(x)];
             }
         const double       point_weight  = parameters.point_weight;
+        const bool         empty_cost    = empty_cells_cost(parameters);
         const unsigned int lattice_cells = lattice_cells_per_grid_cell;
         using CellIterator        = typename dealii::Triangulation<dim>::cell_iterator;
         using CellStatus          = typename dealii::Triangulation<dim>::CellStatus;
@@ -174,7 +181,7 @@ namespace mpm
         // p4est's int weights). Every child given the lattice cell at the parent's centre, as
         // before, left the build's partition unlike the repartition's (doc/log.md, 2026-12-02).
         weights = triangulation.signals.weight.connect(
-          [&points_in_cell, point_weight, lattice_cells, this, parent = std::pair<int, int>(-1, -1),
+          [&points_in_cell, point_weight, empty_cost, lattice_cells, this, parent = std::pair<int, int>(-1, -1),
            next_child = 0u](
             const CellIterator &cell, const CellStatus status) mutable -> unsigned int {
             constexpr unsigned int last_vertex = dealii::GeometryInfo<dim>::vertices_per_cell - 1;
@@ -216,7 +223,7 @@ namespace mpm
                 points += points_in_cell[index];
               }
             // A deal.II cell's weight: k^dim times that mean.
-            return cell_partition_weight(points * lattice_cells / n, point_weight, lattice_cells);
+            return cell_partition_weight(points * lattice_cells / n, point_weight, lattice_cells, empty_cost);
           });
       }
     triangulation.refine_global(levels);

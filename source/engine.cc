@@ -13,6 +13,25 @@ namespace mpm
 {
   namespace
   {
+    // Several ranks with the pressure averaging's cell sums at each cell's lowest vertex (the
+    // nodes near the material): summed over the ranks as the nodal sums are. The vertex is a
+    // node of every rank whose points reach the cell.
+    template <typename Exchange>
+    struct CellSumsAtNodes
+    {
+      Exchange nodes;
+      template <typename Real>
+      void sum_nodal(Real *const *arrays, const int count) const
+      {
+        nodes.sum_nodal(arrays, count);
+      }
+      template <typename Real>
+      void sum_cells(Real *const *arrays, const int count) const
+      {
+        nodes.sum_nodal(arrays, count);
+      }
+    };
+
     // Real: the type the points, the nodes and the step are in (double, or float with
     // Backend/Precision = float: built-in materials; the interface stays in double and the
     // engine converts where points, settings and totals cross it).
@@ -52,9 +71,10 @@ namespace mpm
 
       // Several ranks: the nodes are the grid's local ones (owned, then ghosts), summed over
       // ranks through its partitioner: in double the grid's vectors themselves, in float the
-      // engine's own arrays in the same numbering (shared_view).
+      // engine's own arrays in the same numbering (shared_view). With active_block_cells > 0
+      // the node loops visit only the nodes near the material (choose_listed_nodes).
       CpuEngine(BackgroundGrid<dim> &grid, const std::vector<MaterialParameters<double>> &materials,
-                const ShapeFunction shape)
+                const ShapeFunction shape, const int active_block_cells)
         : shared_grid(&grid)
         , materials(converted<Real>(materials))
         , shape(shape)
@@ -65,7 +85,10 @@ namespace mpm
             own_nodes.origin[d]  = grid.origin[d];
             own_nodes.n_cells[d] = grid.n_cells[d];
           }
-        own_nodes.allocate_cells(); // the pressure averaging's cell sums
+        this->near_material.block_cells = active_block_cells;
+        this->near_material.shape       = shape;
+        if (active_block_cells == 0)
+          own_nodes.allocate_cells(); // the pressure averaging's cell sums; near the material at the nodes
       }
 
       void load(const MaterialPoints<dim> &p) override
@@ -143,6 +166,8 @@ namespace mpm
         const auto &near = this->near_material;
         if (!chooser)
           chooser = std::make_unique<NodeBlockChooser<dim>>(own_nodes.n_cells, near.block_cells);
+        if (shared_grid != nullptr)
+          return choose_listed_nodes();
         choose_nodes_near_material(near.block_cells, [&]() {
           chooser->choose(blocks_holding_points<dim>(own_nodes.origin, own_nodes.h, own_nodes.n_cells,
                                                      near.block_cells, points.view(), &home_cells));
@@ -160,6 +185,70 @@ namespace mpm
         own_nodes.cell_volume.assign(n, 0.0); // the cells' sums at their lowest vertex
         own_nodes.cell_pressure_volume.assign(n, 0.0);
         this->near_material.kept(n, numbered_by_box);
+      }
+
+      // Several ranks: every rank keeps the node blocks around the cell blocks that hold a
+      // point on any rank (a byte per block, the maximum over the ranks), so that the owner of
+      // a node zeroes and updates it wherever another rank's points add into it. The arrays
+      // stay those of the rank's whole part of the grid; the node loops visit the kept nodes
+      // (GridView::node_list), and a node no longer kept is zeroed (the grid files read them).
+      // The blocks are those of the points' home cells, from which the re-sorts measure how
+      // far the points have gone: re-sorted at most the shape's safe distance out, well
+      // inside the margin. Collective: load() runs on every rank.
+      void choose_listed_nodes()
+      {
+        const int  B        = this->near_material.block_cells;
+        const long n_blocks = mpm::n_blocks<dim>(own_nodes.n_cells, B);
+        AssertThrow(n_blocks <= std::numeric_limits<int>::max(),
+                    dealii::ExcMessage("Grid/Active block size = " + std::to_string(B) + ": the grid has more "
+                                       "blocks than one MPI message can count on several ranks. Allowed values "
+                                       "are 1 to 64: choose a larger block size."));
+        AssertThrow(home_cells.size() == static_cast<std::size_t>(points.size()),
+                    dealii::ExcMessage("Internal: the home cells are known only for points loaded from the "
+                                       "ParticleHandler."));
+        std::vector<unsigned char> holding(n_blocks, 0);
+        const auto                 view = points.view();
+        for (int i = 0; i < view.n_points; ++i)
+          if (view.material[i] >= 0)
+            holding[block_of_cell<dim>(home_cells[i], own_nodes.n_cells, B)] = 1;
+        const int mpi_error = MPI_Allreduce(MPI_IN_PLACE, holding.data(), static_cast<int>(n_blocks),
+                                            MPI_UNSIGNED_CHAR, MPI_MAX, shared_grid->communicator);
+        AssertThrowMPI(mpi_error);
+        std::vector<long> blocks;
+        for (long b = 0; b < n_blocks; ++b)
+          if (holding[b] != 0)
+            blocks.push_back(b);
+        choose_nodes_near_material(B, [&]() { chooser->choose(blocks); });
+
+        GridView<dim, Real> g      = shared_view(); // (float: its arrays made for a new partition)
+        const bool          same   = listed_for == shared_grid->partitioner;
+        std::vector<int>    before = std::move(listed_nodes);
+        listed_nodes.clear();
+        for (const long lattice : chooser->nodes().lattice_of_node)
+          if (lattice >= 0 && g.lattice_to_node[lattice] >= 0)
+            listed_nodes.push_back(g.lattice_to_node[lattice]);
+        std::sort(listed_nodes.begin(), listed_nodes.end());
+        if (same) // the arrays hold the last steps' values: zero the nodes left out now
+          {
+            std::vector<bool> kept(g.n_nodes, false);
+            for (const int n : listed_nodes)
+              kept[n] = true;
+            for (const int n : before)
+              if (!kept[n])
+                {
+                  g.mass[n] = 0;
+                  for (int d = 0; d < dim; ++d)
+                    g.momentum[d][n] = g.force[d][n] = g.velocity[d][n] = 0;
+                }
+          }
+        else // a new partition: new arrays, zero
+          {
+            own_nodes.cell_volume.assign(g.n_nodes, 0.0);
+            own_nodes.cell_pressure_volume.assign(g.n_nodes, 0.0);
+            listed_for = shared_grid->partitioner;
+          }
+        this->near_material.kept(static_cast<long>(dealii::Utilities::MPI::sum(double(listed_nodes.size()),
+                                                                               shared_grid->communicator)));
       }
 
       void cells_with_mass(typename GridSnapshot<dim>::LatticeCells &out) override
@@ -270,6 +359,17 @@ namespace mpm
                                                         converted<Real>(s), static_cast<Real>(dt),
                                                         NoGridExchange()));
           }
+        if (this->follows_material())
+          {
+            GridView<dim, Real> g = shared_view();
+            g.node_list           = listed_nodes.data();
+            g.n_listed            = static_cast<int>(listed_nodes.size());
+            g.cell_sums_at_nodes  = true;
+            return converted<double>(explicit_step<dim>(backend, shape, g, points.view(), materials.data(),
+                                                        converted<Real>(s), static_cast<Real>(dt),
+                                                        CellSumsAtNodes<typename BackgroundGrid<dim>::Exchange>{
+                                                          shared_grid->exchange()}));
+          }
         return converted<double>(explicit_step<dim>(backend, shape, shared_view(), points.view(), materials.data(),
                                                     converted<Real>(s), static_cast<Real>(dt),
                                                     shared_grid->exchange()));
@@ -349,6 +449,10 @@ namespace mpm
       bool                                    numbered_by_box = false; // or as the box around them:
       NodeBox<dim>                            box;
       std::vector<long>                       lattice_of_box_node;
+      // Several ranks, nodes near the material: the local nodes kept, ascending, and the
+      // partition they were chosen in (the cell sums sit at the nodes then).
+      std::vector<int>                                           listed_nodes;
+      std::shared_ptr<const dealii::Utilities::MPI::Partitioner> listed_for;
 
       const std::vector<long> &lattice_of_kept_node() const
       {
@@ -407,18 +511,19 @@ namespace mpm
   template <int dim>
   std::unique_ptr<Engine<dim>> make_engine(const std::string &backend, BackgroundGrid<dim> &grid,
                                            const std::vector<MaterialParameters<double>> &materials,
-                                           const ShapeFunction shape, const bool single_precision)
+                                           const ShapeFunction shape, const bool single_precision,
+                                           const int active_block_cells)
   {
     check_backend(backend);
     if (single_precision)
       {
         refuse_user_materials_in_float(materials);
         if (backend == "cpu")
-          return std::make_unique<CpuEngine<dim, float>>(grid, materials, shape);
+          return std::make_unique<CpuEngine<dim, float>>(grid, materials, shape, active_block_cells);
       }
-    if (backend == "cuda") // throws where a rank finds no device
+    if (backend == "cuda") // throws where a rank finds no device; keeps every node of its part
       return make_cuda_engine<dim>(grid, materials, shape, single_precision);
-    return std::make_unique<CpuEngine<dim>>(grid, materials, shape);
+    return std::make_unique<CpuEngine<dim>>(grid, materials, shape, active_block_cells);
   }
 
   template std::unique_ptr<Engine<2>> make_engine(const std::string &, const HostGrid<2, double> &,
@@ -429,8 +534,8 @@ namespace mpm
                                                   bool);
   template std::unique_ptr<Engine<2>> make_engine(const std::string &, BackgroundGrid<2> &,
                                                   const std::vector<MaterialParameters<double>> &, ShapeFunction,
-                                                  bool);
+                                                  bool, int);
   template std::unique_ptr<Engine<3>> make_engine(const std::string &, BackgroundGrid<3> &,
                                                   const std::vector<MaterialParameters<double>> &, ShapeFunction,
-                                                  bool);
+                                                  bool, int);
 } // namespace mpm

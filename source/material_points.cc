@@ -91,6 +91,7 @@ namespace mpm
     // The cell weights of the load balance: cell_partition_weight (background_grid.h).
     const double point_weight = parameters.point_weight;
     this->point_weight        = (cell_partition_weight(1, point_weight) - cell_partition_weight(0, point_weight)) / 16.;
+    empty_cells_weigh         = empty_cells_cost(parameters);
     using CellStatus                 = typename dealii::Triangulation<dim>::CellStatus;
     const unsigned int lattice_cells = grid.lattice_cells_per_grid_cell;
     weight_connection                = grid.triangulation.signals.weight.connect(
@@ -98,7 +99,8 @@ namespace mpm
                                           const CellStatus status) -> unsigned int {
         // The background grid is never refined or coarsened: only CELL_PERSIST occurs.
         (void)status;
-        return cell_partition_weight(handler.n_particles_in_cell(cell), point_weight, lattice_cells);
+        return cell_partition_weight(handler.n_particles_in_cell(cell), point_weight, lattice_cells,
+                                     empty_cells_weigh);
       });
   }
 
@@ -687,11 +689,16 @@ namespace mpm
   template <int dim>
   double MaterialPoints<dim>::imbalance(const double n_local_points) const
   {
-    // The work model of the partition's cell weights: cells plus weighted points.
-    const double local = double(grid.distributed ? grid.distributed->n_locally_owned_active_cells() :
-                                                   grid.triangulation.n_active_cells()) *
-                           grid.lattice_cells_per_grid_cell +
-                         point_weight * n_local_points;
+    // The work model of the partition's cell weights: cells (or only those with points)
+    // plus weighted points.
+    double cells = 0;
+    if (empty_cells_weigh)
+      cells = double(grid.distributed ? grid.distributed->n_locally_owned_active_cells() :
+                                        grid.triangulation.n_active_cells());
+    else
+      for (const auto &cell : grid.triangulation.active_cell_iterators())
+        cells += cell->is_locally_owned() && handler.n_particles_in_cell(cell) > 0 ? 1 : 0;
+    const double local = cells * grid.lattice_cells_per_grid_cell + point_weight * n_local_points;
     const double most  = dealii::Utilities::MPI::max(local, grid.communicator);
     const double total = dealii::Utilities::MPI::sum(local, grid.communicator);
     return total > 0 ? most * grid.n_ranks / total : 1.0;

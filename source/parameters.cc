@@ -193,8 +193,10 @@ namespace mpm
                       "numbered as the box around them where that box holds at most twice the kept blocks (no "
                       "lookup per node: as fast as every node of a box that size), else through a table with "
                       "one entry per block of nodes (no array over the whole box, so the box can be far larger "
-                      "than the memory its nodes would take). One rank only for now; on several ranks each rank "
-                      "keeps every node of its part of the grid.");
+                      "than the memory its nodes would take). On several ranks (Backend = cpu) the step visits "
+                      "only the kept nodes of each rank's part of the grid, whose arrays and deal.II's grid of the "
+                      "box are still built, and the partition weighs only the cells with points; with Backend = "
+                      "cuda on several ranks each rank keeps every node of its part.");
     prm.declare_entry("Active block size", "4", Patterns::Integer(1, 64),
                       "Nodes = near material: edge of the blocks, in cells. Every cell within this many cells "
                       "of a point's cell is kept; larger blocks choose the nodes less often but keep more. The "
@@ -493,7 +495,9 @@ namespace mpm
                       "re-sort. 0 = never repartition; otherwise at least 1.");
     prm.declare_entry("Point weight", "20", Patterns::Double(0),
                       "MPI runs: work of one material point relative to one empty grid cell, for the weighted "
-                      "partition (a cell weighs 1 + Point weight x its points).");
+                      "partition (a cell weighs 1 + Point weight x its points; with Grid/Nodes = near material "
+                      "and Backend = cpu a cell without points weighs nothing, since the step does not visit "
+                      "its nodes).");
     prm.leave_subsection();
 
     prm.enter_subsection("Initial state");

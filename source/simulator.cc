@@ -338,7 +338,7 @@ namespace mpm
         if (cuda_ready.valid())
           cuda_ready.get();
         s.engine = make_engine<dim>(parameters.backend, *s.grid, s.materials, parameters.shape_function,
-                                    parameters.single_precision);
+                                    parameters.single_precision, parameters.active_block_cells);
         s.engine->set_sort_interval(parameters.sort_interval);
         s.engine->load(*s.points);
         s.timer.leave_subsection();
@@ -509,12 +509,16 @@ namespace mpm
             << "  loss checks: " << s.n_points_initial - s.n_removed << " points in the grid + " << s.n_removed
             << " removed = " << s.n_points_initial << " initial; mass in the grid + removed = initial mass to "
             << s.worst_mass_balance << " (largest relative difference over the history rows)\n";
-    if (s.engine->follows_material())
+    if (s.engine->follows_material() && s.parallel)
+      s.pcout << "  nodes near the material: " << s.engine->n_active_nodes() << " at the end, "
+              << s.engine->most_nodes() << " at most (summed over the ranks); chosen again "
+              << std::max(0L, s.engine->node_choices() - 1) << " times (at every re-sort and repartition)\n";
+    else if (s.engine->follows_material())
       s.pcout << "  nodes near the material: " << s.engine->n_active_nodes() << " at the end, "
               << s.engine->most_nodes() << " at most; chosen again " << s.n_node_refreshes
               << " times; the points' distances from the cells they were in checked in " << s.n_home_checks
               << " of " << steps << " steps\n";
-    if (s.engine->follows_material())
+    if (s.engine->follows_material() && !s.parallel)
       s.pcout << "  nodes near the material: numbered as the box around the material (no lookup) in "
               << s.engine->node_choices_as_box() << " of " << s.engine->node_choices()
               << " choices (the others through the block table)\n";

@@ -626,13 +626,19 @@ namespace mpm
         pcout << "  deal.II's grid: " << n_cells / dealii::Utilities::pow(parameters.cells_per_grid_cell, dim)
               << " cells of " << parameters.cells_per_grid_cell << "^" << dim << " (Grid/Cells per deal.II cell)"
               << std::endl;
-      if (engine->follows_material())
+      if (engine->follows_material() && parallel)
+        pcout << "  nodes near the material: " << engine->n_active_nodes() << " of the " << n_nodes
+              << " (blocks of " << parameters.active_block_cells << " cells; summed over the ranks, a node on each "
+              << "rank that holds it), chosen again at every re-sort; each rank's node arrays still span its part "
+                 "of the grid"
+              << std::endl;
+      else if (engine->follows_material())
         pcout << "  nodes near the material: " << engine->n_active_nodes() << " of the " << n_nodes
               << " (blocks of " << parameters.active_block_cells << " cells), chosen again once a point is more than "
               << resort_at << " cells out of the cell it was in" << std::endl;
       else if (parallel && parameters.active_block_cells > 0)
-        pcout << "  Grid/Nodes = near material is for one rank so far: each rank keeps every node of its part "
-                 "of the grid"
+        pcout << "  Grid/Nodes = near material with Backend = cuda is for one rank so far: each rank keeps every "
+                 "node of its part of the grid"
               << std::endl;
     }
 
@@ -726,7 +732,7 @@ namespace mpm
           partition_by_current_work();
           if (!engine)
             engine = make_engine<dim>(parameters.backend, *grid, materials, parameters.shape_function,
-                                      parameters.single_precision);
+                                      parameters.single_precision, parameters.active_block_cells);
           engine->load(*points);
         }
       else

@@ -4,17 +4,22 @@
 # every output are identical, that the near-material run kept fewer nodes than the lattice
 # has and chose them again at least MIN_REFRESHES times (so the refresh was exercised), with
 # the drift bound verified every step (MPM_VERIFY_DRIFT_BOUND); and that its grid files hold
-# fewer cells with the same nodal values wherever there is mass (compare_grid_mass.py).
-# Usage: nodes_near_material.sh EXE PRM OUTDIR MIN_REFRESHES [override lines...]
+# fewer cells with the same nodal values wherever there is mass (compare_grid_mass.py; on several
+# ranks as many cells).
+# Usage: [NP=n] nodes_near_material.sh EXE PRM OUTDIR MIN_REFRESHES [override lines...]
+# NP (default 1): both runs on that many MPI ranks; the particles then agree to round-off (the
+# partitions differ) and each rank starts with at most 1.1 times the mean number of points
+# (unless UNEVEN_OK is set: a partition by cells, Parallel/Load balance threshold = 0).
 set -eu
 exe=$1 prm=$2 out=$3 min_refreshes=$4
 shift 4
+np=${NP:-1}
 here=$(dirname "$0")
 table=("subsection Output" "  set Write particle table = true" "end")
-bash "$here/run_scene.sh" "$exe" "$prm" "$out/all" 1 "${table[@]}" "$@" \
+bash "$here/run_scene.sh" "$exe" "$prm" "$out/all" "$np" "${table[@]}" "$@" \
   "subsection Grid" "  set Nodes = all" "end" > "$out-all.log" 2>&1 ||
   { cat "$out-all.log"; echo "FAILED: the run with Nodes = all failed"; exit 1; }
-MPM_VERIFY_DRIFT_BOUND=1 bash "$here/run_scene.sh" "$exe" "$prm" "$out/near" 1 "${table[@]}" "$@" \
+MPM_VERIFY_DRIFT_BOUND=1 bash "$here/run_scene.sh" "$exe" "$prm" "$out/near" "$np" "${table[@]}" "$@" \
   "subsection Grid" "  set Nodes = near material" "end" > "$out-near.log" 2>&1 ||
   { cat "$out-near.log"; echo "FAILED: the run with Nodes = near material failed"; exit 1; }
 grep "nodes near the material" "$out-near.log"
@@ -26,10 +31,22 @@ refreshes=$(sed -n 's/.*chosen again \([0-9]*\) times.*/\1/p' "$out-near.log")
 [ "$refreshes" -ge "$min_refreshes" ] ||
   { echo "FAILED: the nodes were chosen again $refreshes times, fewer than $min_refreshes"; exit 1; }
 n=0
-for f in "$out"/all/particle_table_*.csv; do
-  cmp "$f" "$out/near/$(basename "$f")" || { echo "FAILED: $(basename "$f") differs"; exit 1; }
-  n=$((n + 1))
-done
-[ "$n" -gt 0 ] || { echo "FAILED: no particle tables"; exit 1; }
-/usr/bin/python3 "$here/compare_grid_mass.py" "$out/all" "$out/near"
-echo "$n particle tables identical; at most $most of $lattice nodes kept, chosen again $refreshes times"
+if [ "$np" -eq 1 ]; then
+  for f in "$out"/all/particle_table_*.csv; do
+    cmp "$f" "$out/near/$(basename "$f")" || { echo "FAILED: $(basename "$f") differs"; exit 1; }
+    n=$((n + 1))
+  done
+  [ "$n" -gt 0 ] || { echo "FAILED: no particle tables"; exit 1; }
+  /usr/bin/python3 "$here/compare_grid_mass.py" "$out/all" "$out/near"
+else
+  # Several ranks: near the material the partition weighs only the cells with points, so the
+  # runs sum over other partitions: equal to round-off, and the points shared out evenly.
+  /usr/bin/python3 "$here/compare_np.py" "$out/all" "$out/near" --rtol 1e-10
+  /usr/bin/python3 "$here/compare_grid_mass.py" "$out/all" "$out/near" --same-cells --rtol 1e-10
+  counts=$(for f in "$out"/near/particle_table_00000.*.csv; do echo $(($(wc -l < "$f") - 1)); done)
+  echo "points per rank at the start, near the material:" $counts
+  [ -n "${UNEVEN_OK:-}" ] || echo "$counts" | awk -v np="$np" '{ n++; s += $1; if ($1 > m) m = $1 }
+    END { if (n != np || m > 1.1 * s / n) { print "FAILED: the points are not shared out evenly"; exit 1 } }'
+  n=$(ls "$out"/near/particle_table_*.csv | wc -l)
+fi
+echo "$n particle tables compared; at most $most of $lattice nodes kept, chosen again $refreshes times"

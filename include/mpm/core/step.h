@@ -334,13 +334,30 @@ namespace mpm
       return n < g.n_nodes;
     }
 
+    // A loop over n_items node (and cell) indices, or over the grid's node list where it has
+    // one (GridView::node_list: host backends; the cell sums then sit at the nodes).
+    template <int dim, typename Real, typename Backend, typename F>
+    void for_each_grid_node(Backend &backend, const GridView<dim, Real> &g, const int n_items, F &&f)
+    {
+      if constexpr (!atomic_scatter<Backend>::value)
+        if (g.node_list != nullptr)
+          {
+            if (n_items > g.n_nodes)
+              throw std::invalid_argument("GridView::node_list needs the cell sums at the nodes (cell_sums_at_nodes)");
+            const int *list = g.node_list;
+            backend.for_each_node(g.n_listed, [&](const int k) { f(list[k]); });
+            return;
+          }
+      backend.for_each_node(n_items, std::forward<F>(f));
+    }
+
     // Nodal sums to zero before a P2G pass; with cells_too also the pressure averaging's
     // cell sums, in the same pass (one launch less on the device).
     template <int dim, typename Real, typename Backend>
     void reset_grid(Backend &backend, const GridView<dim, Real> &g, const bool mass_too, const bool cells_too = false)
     {
       const int n_cells = cell_sums_to_zero(g, cells_too);
-      backend.for_each_node(g.n_nodes > n_cells ? g.n_nodes : n_cells, [=] MPM_HOST_DEVICE(const int n) {
+      for_each_grid_node(backend, g, g.n_nodes > n_cells ? g.n_nodes : n_cells, [=] MPM_HOST_DEVICE(const int n) {
         if (!zero_cell_sums_then_is_node(g, n, n_cells))
           return;
         if (mass_too)
@@ -638,7 +655,7 @@ namespace mpm
       // zero_cells: also the pressure averaging's cell sums, which this step's P2G has
       // just applied (explicit_step's deferred averaging), in the same launch.
       const int n_cells = cell_sums_to_zero(g, zero_cells);
-      backend.for_each_node(g.n_nodes > n_cells ? g.n_nodes : n_cells, [=] MPM_HOST_DEVICE(const int n) {
+      for_each_grid_node(backend, g, g.n_nodes > n_cells ? g.n_nodes : n_cells, [=] MPM_HOST_DEVICE(const int n) {
         if (!zero_cell_sums_then_is_node(g, n, n_cells))
           return;
         const Real dt = time_step_of(s, dt_given);
@@ -710,7 +727,7 @@ namespace mpm
     template <int dim, typename Real, typename Backend>
     void velocity_from_momentum(Backend &backend, const GridView<dim, Real> &g, const Real mass_tolerance)
     {
-      backend.for_each_node(g.n_nodes, [=] MPM_HOST_DEVICE(const int n) {
+      for_each_grid_node(backend, g, g.n_nodes, [=] MPM_HOST_DEVICE(const int n) {
         const Real m = g.mass[n];
         Real       v[dim];
         for (int d = 0; d < dim; ++d)
@@ -1154,7 +1171,7 @@ namespace mpm
                                const MaterialParameters<Real> *disconnecting = nullptr)
     {
       const int n_cells = cell_sums_to_zero(g, true);
-      backend.for_each_node(n_cells, [=] MPM_HOST_DEVICE(const int c) { zero_cell_sums_then_is_node(g, c, n_cells); });
+      for_each_grid_node(backend, g, n_cells, [=] MPM_HOST_DEVICE(const int c) { zero_cell_sums_then_is_node(g, c, n_cells); });
       scatter_cell_pressure(backend, g, p, exchange, disconnecting);
       finish_pressure_averaging(backend, g, p, disconnecting);
     }

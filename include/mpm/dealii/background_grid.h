@@ -50,8 +50,15 @@ namespace mpm
   // units. Integer weights: scaled by 16 so that fractional point weights keep their
   // meaning. p4est reads each cell's weight as an int: capped there (a Point weight of 1e9
   // wrapped around to a negative weight, and p4est's partition aborted).
-  // A deal.II cell of n_lattice_cells lattice cells costs that many units.
-  unsigned int cell_partition_weight(double n_points, double point_weight, unsigned int n_lattice_cells = 1);
+  // A deal.II cell of n_lattice_cells lattice cells costs that many units. Without
+  // empty_cells_cost a cell without points costs nothing (empty_cells_cost()).
+  unsigned int cell_partition_weight(double n_points, double point_weight, unsigned int n_lattice_cells = 1,
+                                     bool empty_cells_cost = true);
+
+  // Whether the partition's work model counts the cells without points: not where the CPU
+  // step visits only the nodes near the material (Grid/Nodes = near material), whose empty
+  // box costs no step time; a partition by cells would leave the material to few ranks.
+  bool empty_cells_cost(const Parameters &parameters);
 
   template <int dim>
   class BackgroundGrid

@@ -127,10 +127,11 @@ namespace mpm
     // Steps between re-sorts of the points (Backend/Sort interval); engines that do not
     // re-sort ignore it.
     virtual void set_sort_interval(int /*steps*/) {}
-    // One rank, Grid/Nodes = near material: the engine keeps only the nodes near the points
-    // (active_nodes.h). The run refreshes them (refresh_active_nodes) before a point gets
-    // active_node_margin() cells out of the cell it was in at the last refresh; loading
-    // points refreshes them too.
+    // Grid/Nodes = near material: one rank, the engine keeps only the nodes near the points
+    // (active_nodes.h), and the run refreshes them (refresh_active_nodes) before a point gets
+    // active_node_margin() cells out of the cell it was in at the last refresh; several ranks
+    // (cpu), the step visits only those nodes of the rank's part of the grid. Loading points
+    // refreshes them (on several ranks at every re-sort, well inside the margin).
     bool   follows_material() const { return near_material.block_cells > 0; }
     double active_node_margin() const
     {
@@ -143,7 +144,8 @@ namespace mpm
     {
       AssertThrow(false, dealii::ExcMessage("Internal: this engine keeps no nodes of its own to write."));
     }
-    // Nodes the engine updates now, and the most it has had (nodes near the material).
+    // Nodes the engine updates now, and the most it has had (nodes near the material; on
+    // several ranks summed over the ranks, a node counted on each rank that holds it).
     long n_active_nodes() const { return near_material.now; }
     long most_nodes() const { return near_material.most; }
     // Of the choices of nodes near the material so far, those and how many were numbered as
@@ -156,7 +158,7 @@ namespace mpm
     virtual void set_materials(const std::vector<MaterialParameters<double>> &materials) = 0;
 
   protected:
-    // One rank, nodes near the material: what the engine keeps between its choices of nodes.
+    // Nodes near the material: what the engine keeps between its choices of nodes.
     struct NearMaterialNodes
     {
       int                       block_cells = 0; // 0: every node
@@ -195,9 +197,12 @@ namespace mpm
 
   // Several ranks: the nodes are the grid's (cpu: its vectors, or in float the engine's own
   // arrays in their numbering; cuda: the device's copy of the rank's locally relevant nodes),
-  // exchanged through the grid's partitioner. single_precision: cpu only.
+  // exchanged through the grid's partitioner. single_precision: cpu only. active_block_cells
+  // > 0 (cpu): the step visits only the nodes near the material, in blocks of that many cells
+  // (Grid/Nodes = near material); the arrays stay those of the rank's part of the grid.
   template <int dim>
   std::unique_ptr<Engine<dim>> make_engine(const std::string &backend, BackgroundGrid<dim> &grid,
                                            const std::vector<MaterialParameters<double>> &materials,
-                                           ShapeFunction shape, bool single_precision = false);
+                                           ShapeFunction shape, bool single_precision = false,
+                                           int active_block_cells = 0);
 } // namespace mpm

@@ -153,7 +153,8 @@ namespace mpm
     unsigned int copy_from(const HostPoints<dim, double> &points);
 
     // Largest work of one rank over the mean (1 = perfectly balanced), work being the
-    // partition's weights: owned cells + Point weight x owned points.
+    // partition's weights: owned cells (with points only, where empty cells cost nothing:
+    // empty_cells_cost) + Point weight x owned points.
     double imbalance() const;
     // The same with this rank's number of points given (an engine that re-sorts without
     // the handler knows it; the handler's count is then out of date).
@@ -174,6 +175,7 @@ namespace mpm
   private:
     BackgroundGrid<dim> &grid;
     double                             point_weight;
+    bool                               empty_cells_weigh = true; // empty_cells_cost (background_grid.h)
     boost::signals2::scoped_connection weight_connection;
   };
 } // namespace mpm
