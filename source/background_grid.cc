@@ -1,4 +1,5 @@
 #include <mpm/dealii/background_grid.h>
+#include <mpm/core/active_nodes.h>
 
 #include <deal.II/base/partitioner.templates.h>
 #include <deal.II/base/quadrature_lib.h>
@@ -144,6 +145,24 @@ namespace mpm
       }
     for (unsigned int d = 0; d < dim; ++d)
       repetitions[d] = n_cells[d] / k >> levels;
+    finest_level = levels;
+    // Near the material on several ranks (CPU): fine only around the start points (every rank
+    // has all of them), grown later as the points spread (MaterialPoints::refine_near_points).
+    if (n_ranks > 1 && !empty_cells_cost(parameters))
+      {
+        fine_block_cells = parameters.active_block_cells;
+        fine_blocks.assign(mpm::n_blocks<dim>(n_cells, fine_block_cells), 0);
+        std::vector<unsigned char> holding(fine_blocks.size(), 0);
+        for (const HostPoints<dim, double> *points : start_points)
+          for (int i = 0; i < points->size(); ++i)
+            {
+              double x[dim];
+              for (int d = 0; d < dim; ++d)
+                x[d] = points->position[d][i];
+              holding[block_of(x)] = 1;
+            }
+        fine_region_misses(holding);
+      }
     // colorize: boundary ids 0..2dim-1 for x min, x max, y min, ...; children inherit them.
     dealii::GridGenerator::subdivided_hyper_rectangle(triangulation, repetitions, p1, p2, true);
     // Several ranks: p4est partitions the refined cells by the start points' work (the
@@ -226,8 +245,16 @@ namespace mpm
             return cell_partition_weight(points * lattice_cells / n, point_weight, lattice_cells, empty_cost);
           });
       }
-    triangulation.refine_global(levels);
-    if (weights.connected() && levels == 0) // no refinement, so no partition after it
+    bool refined = false;
+    if (coarse_away_from_material())
+      for (unsigned int level = 0; level < levels && flag_cells_to_refine(); ++level, refined = true)
+        triangulation.execute_coarsening_and_refinement();
+    else
+      {
+        triangulation.refine_global(levels);
+        refined = levels > 0;
+      }
+    if (weights.connected() && !refined) // no refinement, so no partition after it
       distributed->repartition();
     weights.disconnect();
     distribute_nodes();
@@ -253,11 +280,13 @@ namespace mpm
     std::vector<std::uint8_t> cell_state(n_lattice_cells, 0);
     cell_of_lattice_cell.assign(n_lattice_cells, triangulation.end());
     for (const auto &cell : triangulation.active_cell_iterators())
-      if (cell->is_locally_owned())
+      if (cell->is_locally_owned() && is_fine(cell))
         for_each_lattice_cell(cell, [&](const long c) {
           cell_state[c]           = 1;
           cell_of_lattice_cell[c] = cell;
         });
+      else if (cell->is_locally_owned()) // coarse, away from the material: no nodes
+        for_each_covered_lattice_cell(cell, [&](const long c) { cell_of_lattice_cell[c] = cell; });
     auto cell_coordinates = [&](long index, long idx[dim]) {
       for (int d = 0; d < dim; ++d)
         {
@@ -287,7 +316,7 @@ namespace mpm
       return false;
     };
     for (const auto &cell : triangulation.active_cell_iterators())
-      if (cell->is_ghost())
+      if (cell->is_ghost() && is_fine(cell))
         for_each_lattice_cell(cell, [&](const long c) {
           long idx[dim];
           cell_coordinates(c, idx);
@@ -324,7 +353,7 @@ namespace mpm
         dealii::DoFTools::extract_locally_active_dofs(dof_handler, locally_relevant_dofs); // the owned cells'
         std::vector<dealii::types::global_dof_index> layer;
         for (const auto &cell : dof_handler.active_cell_iterators())
-          if (cell->is_ghost())
+          if (cell->is_ghost() && is_fine(cell))
             for_each_relevant_dof(cell, [&](const auto dof, long) { layer.push_back(dof); });
         std::sort(layer.begin(), layer.end());
         layer.erase(std::unique(layer.begin(), layer.end()), layer.end());
@@ -343,7 +372,7 @@ namespace mpm
     const unsigned int n_local_nodes = partitioner->locally_owned_size() + partitioner->n_ghost_indices();
     auto               node_map      = std::make_shared<std::vector<int>>(n_lattice_nodes, -1);
     for (const auto &cell : dof_handler.active_cell_iterators())
-      if (!cell->is_artificial())
+      if (!cell->is_artificial() && is_fine(cell)) // a coarse cell's DoFs are no lattice nodes
         for_each_relevant_dof(cell, [&](const auto dof, const long node) {
           (*node_map)[node] = static_cast<int>(partitioner->global_to_local(dof));
         });
@@ -395,7 +424,7 @@ namespace mpm
           first_owned = std::min(first_owned, cell->global_active_cell_index());
           ++n_owned;
         }
-      else if (cell->is_ghost())
+      else if (cell->is_ghost() && is_fine(cell))
         {
           int s = 0;
           for_each_lattice_cell(cell, [&](const long c) {
@@ -414,10 +443,12 @@ namespace mpm
     auto cells = std::make_shared<dealii::Utilities::MPI::Partitioner>(owned_cells, ghost_cell_set, communicator);
     lattice_cell_of_local_cell_index.assign(cells->locally_owned_size() + cells->n_ghost_indices(), -1);
     for (const auto &cell : triangulation.active_cell_iterators())
-      if (cell->is_locally_owned() || cell->is_ghost())
+      if (cell->is_locally_owned() || (cell->is_ghost() && is_fine(cell)))
         {
           AssertThrow(!cell->is_locally_owned() || cell->global_active_cell_index() - first_owned < n_owned,
                       dealii::ExcInternalError()); // the owned cells' indices are one range
+          if (!is_fine(cell)) // a coarse owned cell's entries stay -1: no lattice cell
+            continue;
           int s = 0;
           for_each_lattice_cell(cell, [&](const long c) {
             const dealii::types::global_cell_index global = cell->global_active_cell_index() * kd + s++;
@@ -426,6 +457,134 @@ namespace mpm
           });
         }
     cell_partitioner = cells;
+  }
+
+  template <int dim>
+  template <typename F>
+  void BackgroundGrid<dim>::for_each_covered_lattice_cell(const typename dealii::Triangulation<dim>::cell_iterator &cell,
+                                                          F f) const
+  {
+    long first[dim], count[dim], n = 1;
+    lower_lattice_corner(cell, first);
+    const dealii::Point<dim> upper = cell->vertex(dealii::GeometryInfo<dim>::vertices_per_cell - 1);
+    for (int d = 0; d < dim; ++d)
+      {
+        count[d] = std::lround((upper[d] - origin[d]) / h) - first[d];
+        n *= count[d];
+      }
+    for (long j = 0; j < n; ++j)
+      {
+        long index = 0, rest = j, at[dim];
+        for (int d = 0; d < dim; ++d)
+          {
+            at[d] = first[d] + rest % count[d];
+            rest /= count[d];
+          }
+        for (int d = dim - 1; d >= 0; --d)
+          index = index * n_cells[d] + at[d];
+        f(index);
+      }
+  }
+
+  template <int dim>
+  bool BackgroundGrid<dim>::meets_blocks(const typename dealii::Triangulation<dim>::cell_iterator &cell,
+                                         const std::vector<unsigned char>                    &blocks) const
+  {
+    const int B = fine_block_cells;
+    long      first[dim], lo[dim], hi[dim], nb[dim], n = 1;
+    lower_lattice_corner(cell, first);
+    const dealii::Point<dim> upper = cell->vertex(dealii::GeometryInfo<dim>::vertices_per_cell - 1);
+    for (int d = 0; d < dim; ++d)
+      {
+        lo[d] = first[d] / B;
+        hi[d] = (std::lround((upper[d] - origin[d]) / h) - 1) / B;
+        nb[d] = n_blocks_along<dim>(n_cells[d], B);
+        n *= hi[d] - lo[d] + 1;
+      }
+    for (long j = 0; j < n; ++j)
+      {
+        long block = 0, rest = j, at[dim];
+        for (int d = 0; d < dim; ++d)
+          {
+            at[d] = lo[d] + rest % (hi[d] - lo[d] + 1);
+            rest /= hi[d] - lo[d] + 1;
+          }
+        for (int d = dim - 1; d >= 0; --d)
+          block = block * nb[d] + at[d];
+        if (blocks[block] != 0)
+          return true;
+      }
+    return false;
+  }
+
+  template <int dim>
+  long BackgroundGrid<dim>::block_of(const double *x) const
+  {
+    return block_of_cell<dim>(lattice_cell_of(x), n_cells, fine_block_cells);
+  }
+
+  template <int dim>
+  bool BackgroundGrid<dim>::fine_region_misses(const std::vector<unsigned char> &holding)
+  {
+    const int B = fine_block_cells;
+    long      nb[dim];
+    for (int d = 0; d < dim; ++d)
+      nb[d] = n_blocks_along<dim>(n_cells[d], B);
+    // The blocks within `reach` blocks (max-norm) of a flagged one.
+    const auto dilated = [&](const int reach) {
+      std::vector<unsigned char> out(holding.size(), 0);
+      const int width = 2 * reach + 1;
+      for (long b = 0; b < static_cast<long>(holding.size()); ++b)
+        if (holding[b] != 0)
+          {
+            long at[dim], rest = b;
+            for (int d = 0; d < dim; ++d)
+              {
+                at[d] = rest % nb[d];
+                rest /= nb[d];
+              }
+            for (int j = 0; j < dealii::Utilities::pow(width, dim); ++j)
+              {
+                long neighbour = 0;
+                bool inside    = true;
+                for (int d = dim - 1, r = j; d >= 0; --d)
+                  {
+                    const int  step = dealii::Utilities::pow(width, d);
+                    const long i    = at[d] - reach + r / step;
+                    r %= step;
+                    inside    = inside && i >= 0 && i < nb[d];
+                    neighbour = neighbour * nb[d] + (inside ? i : 0);
+                  }
+                if (inside)
+                  out[neighbour] = 1;
+              }
+          }
+      return out;
+    };
+    const std::vector<unsigned char> kept = dilated(1);
+    bool                             miss = false;
+    for (std::size_t b = 0; b < kept.size() && !miss; ++b)
+      miss = kept[b] != 0 && fine_blocks[b] == 0;
+    if (miss)
+      {
+        const std::vector<unsigned char> grown = dilated(2);
+        for (std::size_t b = 0; b < grown.size(); ++b)
+          fine_blocks[b] |= grown[b];
+      }
+    return miss;
+  }
+
+  template <int dim>
+  bool BackgroundGrid<dim>::flag_cells_to_refine()
+  {
+    int flagged = 0;
+    for (const auto &cell : triangulation.active_cell_iterators())
+      if (cell->is_locally_owned() && cell->level() < finest_level && meets_blocks(cell, fine_blocks))
+        {
+          cell->set_refine_flag();
+          flagged = 1;
+        }
+    return dealii::Utilities::MPI::max(flagged, communicator) > 0;
   }
 
   template <int dim>
@@ -582,12 +741,13 @@ namespace mpm
       {
         local[i] = buffer.data() + i * n_local;
         for (std::size_t c = 0; c < n_local; ++c)
-          local[i][c] = arrays[i][lattice_cell_of_local_cell_index[c]];
+          local[i][c] = lattice_cell_of_local_cell_index[c] < 0 ? Real(0) : arrays[i][lattice_cell_of_local_cell_index[c]];
       }
     cell_exchange.sum(cell_partitioner, local.data(), count);
     for (int i = 0; i < count; ++i)
       for (std::size_t c = 0; c < n_local; ++c)
-        arrays[i][lattice_cell_of_local_cell_index[c]] = local[i][c];
+        if (lattice_cell_of_local_cell_index[c] >= 0) // not a coarse cell's
+          arrays[i][lattice_cell_of_local_cell_index[c]] = local[i][c];
   }
 
   template class BackgroundGrid<2>;

@@ -190,8 +190,10 @@ namespace mpm
       // Several ranks: every rank keeps the node blocks around the cell blocks that hold a
       // point on any rank (a byte per block, the maximum over the ranks), so that the owner of
       // a node zeroes and updates it wherever another rank's points add into it. The arrays
-      // stay those of the rank's whole part of the grid; the node loops visit the kept nodes
-      // (GridView::node_list), and a node no longer kept is zeroed (the grid files read them).
+      // are those of the rank's fine cells of deal.II's grid (fine within two blocks of the
+      // points, BackgroundGrid::coarse_away_from_material); the node loops visit the kept
+      // nodes (GridView::node_list), and a node no longer kept is zeroed (the grid files read
+      // them).
       // The blocks are those of the points' home cells, from which the re-sorts measure how
       // far the points have gone: re-sorted at most the shape's safe distance out, well
       // inside the margin. Collective: load() runs on every rank.

@@ -97,8 +97,18 @@ namespace mpm
     weight_connection                = grid.triangulation.signals.weight.connect(
       [this, point_weight, lattice_cells](const typename dealii::Triangulation<dim>::cell_iterator &cell,
                                           const CellStatus status) -> unsigned int {
-        // The background grid is never refined or coarsened: only CELL_PERSIST occurs.
-        (void)status;
+        // Refined near the material (refine_near_points): each child of a refined cell (deal.II
+        // hands over the parent, still active) gets its share of the parent's points and cells.
+        // Never coarsened.
+        if (status == dealii::Triangulation<dim>::CELL_REFINE || status == dealii::Triangulation<dim>::CELL_INVALID)
+          {
+            const unsigned int children = dealii::GeometryInfo<dim>::max_children_per_cell;
+            const double points = cell->is_active() ? double(handler.n_particles_in_cell(cell)) / children : 0.0;
+            const unsigned int covered = cell->level() + 1 == this->grid.finest_level ?
+                                           lattice_cells :
+                                           lattice_cells * dealii::Utilities::pow(2, dim * (this->grid.finest_level - cell->level() - 1));
+            return cell_partition_weight(points, point_weight, covered, empty_cells_weigh);
+          }
         return cell_partition_weight(handler.n_particles_in_cell(cell), point_weight, lattice_cells,
                                      empty_cells_weigh);
       });
@@ -702,6 +712,41 @@ namespace mpm
     const double most  = dealii::Utilities::MPI::max(local, grid.communicator);
     const double total = dealii::Utilities::MPI::sum(local, grid.communicator);
     return total > 0 ? most * grid.n_ranks / total : 1.0;
+  }
+
+  template <int dim>
+  bool MaterialPoints<dim>::refine_near_points(const std::function<void()> &before_refining)
+  {
+    if (!grid.coarse_away_from_material())
+      return false;
+    std::vector<unsigned char> holding(grid.n_fine_blocks(), 0);
+    for (const auto &particle : handler)
+      {
+        const dealii::Point<dim> x = particle.get_location();
+        holding[grid.block_of(&x[0])] = 1;
+      }
+    const int mpi_error = MPI_Allreduce(MPI_IN_PLACE, holding.data(), static_cast<int>(holding.size()),
+                                        MPI_UNSIGNED_CHAR, MPI_MAX, grid.communicator);
+    AssertThrowMPI(mpi_error);
+    if (!grid.fine_region_misses(holding))
+      return false;
+    if (before_refining)
+      before_refining();
+    // As repartition(): the handler packs its points with their cells, p4est refines and
+    // moves cells by weight, the handler unpacks them on the new owners (children included).
+    while (grid.flag_cells_to_refine())
+      {
+        handler.prepare_for_coarsening_and_refinement();
+        grid.triangulation.execute_coarsening_and_refinement();
+        handler.unpack_after_coarsening_and_refinement();
+      }
+    ++grid.n_refinements;
+    grid.distribute_nodes();
+    for (const auto &particle : handler) // a point's stencil must find its nodes
+      AssertThrow(grid.is_fine(particle.get_surrounding_cell()),
+                  dealii::ExcMessage("Internal error: a material point lies in a coarse cell of deal.II's grid "
+                                     "after it was refined near the material."));
+    return true;
   }
 
   template <int dim>

@@ -328,6 +328,7 @@ namespace mpm
         count_points();
         s.points = std::make_unique<MaterialPoints<dim>>(*s.grid, parameters);
         s.points->insert(generation.get());
+        s.refine_near_material(); // (built fine around these points already)
         s.timer.leave_subsection();
       }
 
@@ -518,6 +519,9 @@ namespace mpm
               << s.engine->most_nodes() << " at most; chosen again " << s.n_node_refreshes
               << " times; the points' distances from the cells they were in checked in " << s.n_home_checks
               << " of " << steps << " steps\n";
+    if (s.parallel && s.grid->coarse_away_from_material())
+      s.pcout << "  deal.II's grid: fine only near the material, " << s.grid->triangulation.n_global_active_cells()
+              << " cells at the end; refined " << s.grid->n_refinements << " times as the material spread\n";
     if (s.engine->follows_material() && !s.parallel)
       s.pcout << "  nodes near the material: numbered as the box around the material (no lookup) in "
               << s.engine->node_choices_as_box() << " of " << s.engine->node_choices()

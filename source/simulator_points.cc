@@ -104,6 +104,7 @@ namespace mpm
       }
     all.labels = labels;
     s.points->replace(all);
+    s.refine_near_material();
     s.engine->load(*s.points);
     ++s.n_resorts;
     if (s.balance())

@@ -424,11 +424,13 @@ namespace mpm
                                          "number' or the time step."));
           if (distance > resort_at)
             {
+              bool refined;
               {
                 dealii::TimerOutput::Scope scope(timer, "migrate points");
                 resort();
+                refined = refine_near_material();
               }
-              if (balance())
+              if (balance() || refined)
                 engine->load(*points);
               loop_times.resorts += std::chrono::duration<double>(clock::now() - checked).count();
             }
@@ -629,8 +631,8 @@ namespace mpm
       if (engine->follows_material() && parallel)
         pcout << "  nodes near the material: " << engine->n_active_nodes() << " of the " << n_nodes
               << " (blocks of " << parameters.active_block_cells << " cells; summed over the ranks, a node on each "
-              << "rank that holds it), chosen again at every re-sort; each rank's node arrays still span its part "
-                 "of the grid"
+              << "rank that holds it), chosen again at every re-sort; deal.II's grid fine only near the "
+                 "material"
               << std::endl;
       else if (engine->follows_material())
         pcout << "  nodes near the material: " << engine->n_active_nodes() << " of the " << n_nodes
@@ -682,6 +684,18 @@ namespace mpm
       return r;
     }
 
+    // Several ranks near the material: deal.II's grid refined where the points are about to
+    // need it (MaterialPoints::refine_near_points); whether it was (collective).
+    bool refine_near_material()
+    {
+      if (!parallel || !grid->coarse_away_from_material())
+        return false;
+      return points->refine_near_points([&]() {
+        if (output)
+          output->finish(); // a grid output in flight reads the DoFHandler
+      });
+    }
+
     // Several ranks: the partition of the grid by the points' work as it is now (where the
     // run repartitions at all). A pure function of the points' cells, whichever partition the
     // grid had before: a run resumed on an even partition comes to the same one.
@@ -729,6 +743,7 @@ namespace mpm
       if (parallel)
         {
           points->replace(saved);
+          refine_near_material();
           partition_by_current_work();
           if (!engine)
             engine = make_engine<dim>(parameters.backend, *grid, materials, parameters.shape_function,

@@ -6,10 +6,14 @@
 # the drift bound verified every step (MPM_VERIFY_DRIFT_BOUND); and that its grid files hold
 # fewer cells with the same nodal values wherever there is mass (compare_grid_mass.py; on several
 # ranks as many cells).
+# On several ranks deal.II's grid is fine only near the material and must have been refined at least
+# once as it spread.
 # Usage: [NP=n] nodes_near_material.sh EXE PRM OUTDIR MIN_REFRESHES [override lines...]
 # NP (default 1): both runs on that many MPI ranks; the particles then agree to round-off (the
 # partitions differ) and each rank starts with at most 1.1 times the mean number of points
-# (unless UNEVEN_OK is set: a partition by cells, Parallel/Load balance threshold = 0).
+# (unless UNEVEN_OK is set: a partition by cells, Parallel/Load balance threshold = 0). SPREAD_NP
+# (float): the particles and nodal values may differ by up to 10x the difference of Nodes = all on
+# SPREAD_NP ranks from Nodes = all on NP (the round-off of another partition).
 set -eu
 exe=$1 prm=$2 out=$3 min_refreshes=$4
 shift 4
@@ -41,8 +45,18 @@ if [ "$np" -eq 1 ]; then
 else
   # Several ranks: near the material the partition weighs only the cells with points, so the
   # runs sum over other partitions: equal to round-off, and the points shared out evenly.
-  /usr/bin/python3 "$here/compare_np.py" "$out/all" "$out/near" --rtol 1e-10
-  /usr/bin/python3 "$here/compare_grid_mass.py" "$out/all" "$out/near" --same-cells --rtol 1e-10
+  spread=()
+  if [ -n "${SPREAD_NP:-}" ]; then # float: Nodes = all on SPREAD_NP ranks shows the partition's round-off
+    bash "$here/run_scene.sh" "$exe" "$prm" "$out/spread" "$SPREAD_NP" "${table[@]}" "$@" \
+      "subsection Grid" "  set Nodes = all" "end" > "$out-spread.log" 2>&1 ||
+      { cat "$out-spread.log"; echo "FAILED: the run with Nodes = all on $SPREAD_NP ranks failed"; exit 1; }
+    spread=(--spread "$out/spread")
+  fi
+  /usr/bin/python3 "$here/compare_np.py" "$out/all" "$out/near" --rtol 1e-10 "${spread[@]}"
+  /usr/bin/python3 "$here/compare_grid_mass.py" "$out/all" "$out/near" --rtol 1e-10 "${spread[@]}"
+  refinements=$(sed -n "s/.*deal.II's grid: fine only near the material.* refined \([0-9]*\) times.*/\1/p" "$out-near.log")
+  echo "deal.II's grid refined ${refinements:-?} times as the material spread"
+  [ "${refinements:-0}" -ge 1 ] || { echo "FAILED: deal.II's grid was never refined as the material spread"; exit 1; }
   counts=$(for f in "$out"/near/particle_table_00000.*.csv; do echo $(($(wc -l < "$f") - 1)); done)
   echo "points per rank at the start, near the material:" $counts
   [ -n "${UNEVEN_OK:-}" ] || echo "$counts" | awk -v np="$np" '{ n++; s += $1; if ($1 > m) m = $1 }

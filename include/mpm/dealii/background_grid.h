@@ -11,6 +11,10 @@
 // it next to the owned cells). A point whose centre lies in an owned lattice cell, or less
 // than half a cell outside one, has its whole GIMP (and linear) stencil in this set; the
 // step loop keeps every point within that distance (doc/performance.md, MPI).
+//
+// Several ranks with Grid/Nodes = near material (CPU): the cells are of that size only near
+// the material and as coarse as the coarse grid elsewhere (coarse_away_from_material); the
+// node arrays, lookups and masks above cover the fine cells, whose ghost layer is fine too.
 #pragma once
 
 #include <mpm/core/host_storage.h>
@@ -78,8 +82,36 @@ namespace mpm
     // constructor and after every repartition of the triangulation.
     void distribute_nodes();
 
+    // Several ranks with Grid/Nodes = near material (CPU): deal.II's cells are of the full
+    // resolution (k lattice cells) only near the material and as coarse as the coarse grid
+    // elsewhere. The fine region is a set of blocks of Active block size cells, the same on
+    // every rank: the blocks within two blocks of one that holds a point (the nodes kept near
+    // the material lie within one). The nodal arrays and lattice lookups cover the fine cells.
+    bool coarse_away_from_material() const { return fine_block_cells > 0; }
+    // Whether the fine region misses a block within one block of those flagged in holding
+    // (one byte per block, the same on every rank); if so it is grown to every block within
+    // two, and flag_cells_to_refine() then marks the cells to refine.
+    bool fine_region_misses(const std::vector<unsigned char> &holding);
+    // Sets the refine flag of every owned cell coarser than the full resolution that meets
+    // the fine region; whether any rank flagged one (collective).
+    bool flag_cells_to_refine();
+    // The cell blocks (of Active block size cells) of the lattice, and the block of a point.
+    long n_fine_blocks() const { return static_cast<long>(fine_blocks.size()); }
+    long block_of(const double *x) const;
+    // Number of times the fine region grew after the grid was built.
+    int n_refinements = 0;
+    // The level of deal.II's cells of the full resolution (the coarse grid's is 0).
+    int finest_level = 0;
+    // Whether `cell` is of the full resolution (k lattice cells).
+    template <typename CellIterator>
+    bool is_fine(const CellIterator &cell) const
+    {
+      return cell->level() == finest_level;
+    }
+
     // Active cell of the triangulation at lattice cell index i + n_x (j + n_y k),
-    // or triangulation.end() where this rank does not own the cell.
+    // or triangulation.end() where this rank does not own the cell (a coarse cell away from
+    // the material: the cell that holds it).
     typename dealii::Triangulation<dim>::active_cell_iterator owned_cell(long lattice_cell) const;
 
     // Lattice cell index of the cell containing x (clamped to the grid).
@@ -209,6 +241,17 @@ namespace mpm
     std::vector<std::uint8_t> friction_faces;            // empty without a friction face
     double                    friction_coefficient[6] = {}; // by boundary id
     std::vector<typename dealii::Triangulation<dim>::active_cell_iterator> cell_of_lattice_cell;
+
+    // Coarse away from the material: the block edge (0: the grid is uniform) and the fine
+    // region, one byte per cell block.
+    int                        fine_block_cells = 0;
+    std::vector<unsigned char> fine_blocks;
+    // Calls f(lattice cell) for every lattice cell that `cell` covers (at any level).
+    template <typename F>
+    void for_each_covered_lattice_cell(const typename dealii::Triangulation<dim>::cell_iterator &cell, F f) const;
+    // Whether `cell` covers a lattice cell of a block flagged in blocks.
+    bool meets_blocks(const typename dealii::Triangulation<dim>::cell_iterator &cell,
+                      const std::vector<unsigned char> &blocks) const;
 
     // The exchanges over the node and the cell partitioner (all arrays of a call in one
     // round of messages), and the scratch of sum_cells.

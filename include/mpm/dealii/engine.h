@@ -199,7 +199,8 @@ namespace mpm
   // arrays in their numbering; cuda: the device's copy of the rank's locally relevant nodes),
   // exchanged through the grid's partitioner. single_precision: cpu only. active_block_cells
   // > 0 (cpu): the step visits only the nodes near the material, in blocks of that many cells
-  // (Grid/Nodes = near material); the arrays stay those of the rank's part of the grid.
+  // (Grid/Nodes = near material); the arrays are those of the rank's fine cells
+  // (BackgroundGrid::coarse_away_from_material).
   template <int dim>
   std::unique_ptr<Engine<dim>> make_engine(const std::string &backend, BackgroundGrid<dim> &grid,
                                            const std::vector<MaterialParameters<double>> &materials,

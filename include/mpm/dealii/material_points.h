@@ -164,6 +164,14 @@ namespace mpm
     // the cell), moves the points with their cells, and rebuilds the grid's nodes.
     void repartition();
 
+    // Where deal.II's grid is coarse away from the material (several ranks, Grid/Nodes =
+    // near material, CPU): refines it where its fine region misses a block around the
+    // points (BackgroundGrid::fine_region_misses), the points moving with their cells and
+    // the partition following the work, and distributes the nodes again. Whether it did
+    // (collective; the engine must then load the points again). before_refining runs first
+    // where it does (a grid output in flight must finish).
+    bool refine_near_points(const std::function<void()> &before_refining = {});
+
     dealii::Particles::ParticleHandler<dim> handler;
     dealii::types::particle_index           n_generated = 0;
     // Points this rank handed to another rank in copy_from's re-sorts, summed.
