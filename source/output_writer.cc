@@ -160,7 +160,7 @@ namespace mpm
     : rank(rank)
   {
     for (const auto &cell : grid.dof_handler.active_cell_iterators())
-      if (cell->is_locally_owned())
+      if (cell->is_locally_owned() && grid.is_fine(cell)) // (coarse away from the material: no mass, no nodes)
         cells.push_back(cell);
     cells_per_grid_cell = grid.cells_per_grid_cell;
     if (cells_per_grid_cell > 1)
