@@ -228,19 +228,7 @@ namespace mpm
                 n *= count[d];
               }
             double points = 0;
-            for (long j = 0; j < n; ++j)
-              {
-                long index = 0, rest = j;
-                long at[dim];
-                for (int d = 0; d < dim; ++d)
-                  {
-                    at[d] = first[d] + rest % count[d];
-                    rest /= count[d];
-                  }
-                for (int d = dim - 1; d >= 0; --d)
-                  index = index * n_cells[d] + at[d];
-                points += points_in_cell[index];
-              }
+            for_each_lattice_cell_in_box(first, count, [&](const long index) { points += points_in_cell[index]; });
             // A deal.II cell's weight: k^dim times that mean.
             return cell_partition_weight(points * lattice_cells / n, point_weight, lattice_cells, empty_cost);
           });
@@ -464,14 +452,21 @@ namespace mpm
   void BackgroundGrid<dim>::for_each_covered_lattice_cell(const typename dealii::Triangulation<dim>::cell_iterator &cell,
                                                           F f) const
   {
-    long first[dim], count[dim], n = 1;
+    long first[dim], count[dim];
     lower_lattice_corner(cell, first);
     const dealii::Point<dim> upper = cell->vertex(dealii::GeometryInfo<dim>::vertices_per_cell - 1);
     for (int d = 0; d < dim; ++d)
-      {
-        count[d] = std::lround((upper[d] - origin[d]) / h) - first[d];
-        n *= count[d];
-      }
+      count[d] = std::lround((upper[d] - origin[d]) / h) - first[d];
+    for_each_lattice_cell_in_box(first, count, f);
+  }
+
+  template <int dim>
+  template <typename F>
+  void BackgroundGrid<dim>::for_each_lattice_cell_in_box(const long first[dim], const long count[dim], F &&f) const
+  {
+    long n = 1;
+    for (int d = 0; d < dim; ++d)
+      n *= count[d];
     for (long j = 0; j < n; ++j)
       {
         long index = 0, rest = j, at[dim];

@@ -246,9 +246,12 @@ namespace mpm
     // region, one byte per cell block.
     int                        fine_block_cells = 0;
     std::vector<unsigned char> fine_blocks;
-    // Calls f(lattice cell) for every lattice cell that `cell` covers (at any level).
+    // Calls f(lattice cell) for every lattice cell that `cell` covers (at any level), and for
+    // those of the box of count[d] cells from lattice cell first[d] along each axis.
     template <typename F>
     void for_each_covered_lattice_cell(const typename dealii::Triangulation<dim>::cell_iterator &cell, F f) const;
+    template <typename F>
+    void for_each_lattice_cell_in_box(const long first[dim], const long count[dim], F &&f) const;
     // Whether `cell` covers a lattice cell of a block flagged in blocks.
     bool meets_blocks(const typename dealii::Triangulation<dim>::cell_iterator &cell,
                       const std::vector<unsigned char> &blocks) const;
