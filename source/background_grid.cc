@@ -102,6 +102,17 @@ namespace mpm
     return !(parameters.active_block_cells > 0 && parameters.backend == "cpu");
   }
 
+  void flag_blocks_of_every_rank(std::vector<unsigned char> &blocks, const int block_cells, MPI_Comm communicator)
+  {
+    AssertThrow(blocks.size() <= static_cast<std::size_t>(std::numeric_limits<int>::max()),
+                dealii::ExcMessage("Grid/Active block size = " + std::to_string(block_cells) + ": the grid has "
+                                   "more blocks than one MPI message can count on several ranks. Allowed values "
+                                   "are 1 to 64: choose a larger block size."));
+    const int mpi_error = MPI_Allreduce(MPI_IN_PLACE, blocks.data(), static_cast<int>(blocks.size()),
+                                        MPI_UNSIGNED_CHAR, MPI_MAX, communicator);
+    AssertThrowMPI(mpi_error);
+  }
+
   template <int dim>
   BackgroundGrid<dim>::BackgroundGrid(const Parameters &parameters, MPI_Comm communicator,
                                       const std::vector<const HostPoints<dim, double> *> &start_points)

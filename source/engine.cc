@@ -201,10 +201,6 @@ namespace mpm
       {
         const int  B        = this->near_material.block_cells;
         const long n_blocks = mpm::n_blocks<dim>(own_nodes.n_cells, B);
-        AssertThrow(n_blocks <= std::numeric_limits<int>::max(),
-                    dealii::ExcMessage("Grid/Active block size = " + std::to_string(B) + ": the grid has more "
-                                       "blocks than one MPI message can count on several ranks. Allowed values "
-                                       "are 1 to 64: choose a larger block size."));
         AssertThrow(home_cells.size() == static_cast<std::size_t>(points.size()),
                     dealii::ExcMessage("Internal: the home cells are known only for points loaded from the "
                                        "ParticleHandler."));
@@ -213,9 +209,7 @@ namespace mpm
         for (int i = 0; i < view.n_points; ++i)
           if (view.material[i] >= 0)
             holding[block_of_cell<dim>(home_cells[i], own_nodes.n_cells, B)] = 1;
-        const int mpi_error = MPI_Allreduce(MPI_IN_PLACE, holding.data(), static_cast<int>(n_blocks),
-                                            MPI_UNSIGNED_CHAR, MPI_MAX, shared_grid->communicator);
-        AssertThrowMPI(mpi_error);
+        flag_blocks_of_every_rank(holding, B, shared_grid->communicator);
         std::vector<long> blocks;
         for (long b = 0; b < n_blocks; ++b)
           if (holding[b] != 0)

@@ -725,9 +725,7 @@ namespace mpm
         const dealii::Point<dim> x = particle.get_location();
         holding[grid.block_of(&x[0])] = 1;
       }
-    const int mpi_error = MPI_Allreduce(MPI_IN_PLACE, holding.data(), static_cast<int>(holding.size()),
-                                        MPI_UNSIGNED_CHAR, MPI_MAX, grid.communicator);
-    AssertThrowMPI(mpi_error);
+    flag_blocks_of_every_rank(holding, grid.fine_block_size(), grid.communicator);
     if (!grid.fine_region_misses(holding))
       return false;
     if (before_refining)

@@ -83,8 +83,8 @@ namespace mpm
     // above are then n_nodes long, not one entry per lattice cell.
     bool cell_sums_at_nodes = false;
     // Host backends: the only nodes a point can reach, ascending, and their number (several
-    // ranks with the nodes near the material: the rank's arrays hold its whole part of the
-    // grid, the node loops visit these). Null: every node. The cell sums must then sit at
+    // ranks with the nodes near the material: the rank's arrays hold every node of its fine
+    // cells, the node loops visit these). Null: every node. The cell sums must then sit at
     // the nodes.
     const int *node_list = nullptr;
     int        n_listed  = 0;

@@ -64,6 +64,12 @@ namespace mpm
   // box costs no step time; a partition by cells would leave the material to few ranks.
   bool empty_cells_cost(const Parameters &parameters);
 
+  // Several ranks, nodes near the material: block flags (one byte per block of block_cells^dim
+  // cells, 1 where this rank has a point) made the same on every rank, their maximum over the
+  // ranks of communicator (collective). Throws naming Grid/Active block size where the blocks
+  // are more than one MPI message can count.
+  void flag_blocks_of_every_rank(std::vector<unsigned char> &blocks, int block_cells, MPI_Comm communicator);
+
   template <int dim>
   class BackgroundGrid
   {
@@ -97,6 +103,7 @@ namespace mpm
     bool flag_cells_to_refine();
     // The cell blocks (of Active block size cells) of the lattice, and the block of a point.
     long n_fine_blocks() const { return static_cast<long>(fine_blocks.size()); }
+    int  fine_block_size() const { return fine_block_cells; }
     long block_of(const double *x) const;
     // Number of times the fine region grew after the grid was built.
     int n_refinements = 0;
