@@ -35,6 +35,99 @@ namespace mpm
     {
       return parameters.boundary[id] == BoundaryType::friction ? parameters.friction_coefficient : 0.0;
     }
+
+    // A box of lattice entries (cells or nodes, `extent` of them along each axis) and an
+    // entry's index in it, x fastest: arrays over the box around what a rank holds, not over
+    // the lattice, whose box may be mostly empty (Grid/Nodes = near material).
+    template <int dim>
+    struct LatticeBox
+    {
+      long lower[dim], upper[dim]; // inclusive; empty while lower > upper
+
+      LatticeBox()
+      {
+        std::fill(lower, lower + dim, std::numeric_limits<long>::max());
+        std::fill(upper, upper + dim, -1L);
+      }
+      static void coordinates(long entry, const long extent[dim], long idx[dim])
+      {
+        for (int d = 0; d < dim; ++d)
+          {
+            idx[d] = entry % extent[d];
+            entry /= extent[d];
+          }
+      }
+      void add_at(const long idx[dim])
+      {
+        for (int d = 0; d < dim; ++d)
+          {
+            lower[d] = std::min(lower[d], idx[d]);
+            upper[d] = std::max(upper[d], idx[d]);
+          }
+      }
+      void add(const long entry, const long extent[dim])
+      {
+        long idx[dim];
+        coordinates(entry, extent, idx);
+        add_at(idx);
+      }
+      // Grown by `by` entries on every side, within the lattice.
+      void grow(const long by, const long extent[dim])
+      {
+        for (int d = 0; d < dim; ++d)
+          if (lower[d] <= upper[d])
+            {
+              lower[d] = std::max(0L, lower[d] - by);
+              upper[d] = std::min(extent[d] - 1, upper[d] + by);
+            }
+      }
+      long along(const int d) const { return std::max(0L, upper[d] - lower[d] + 1); }
+      long size() const
+      {
+        long n = 1;
+        for (int d = 0; d < dim; ++d)
+          n *= along(d);
+        return n;
+      }
+      long index_at(const long idx[dim]) const
+      {
+        long index = 0;
+        for (int d = dim - 1; d >= 0; --d)
+          {
+            if (idx[d] < lower[d] || idx[d] > upper[d])
+              return -1;
+            index = index * along(d) + idx[d] - lower[d];
+          }
+        return index;
+      }
+      // -1 outside the box.
+      long index(const long entry, const long extent[dim]) const
+      {
+        long idx[dim];
+        coordinates(entry, extent, idx);
+        return index_at(idx);
+      }
+      // The part of the box of count[d] entries from first[d] inside this box; false if none.
+      bool clip(long first[dim], long count[dim]) const
+      {
+        for (int d = 0; d < dim; ++d)
+          {
+            const long from = std::max(first[d], lower[d]), to = std::min(first[d] + count[d] - 1, upper[d]);
+            if (from > to)
+              return false;
+            first[d] = from;
+            count[d] = to - from + 1;
+          }
+        return true;
+      }
+    };
+
+    template <int dim>
+    void cell_extent(const int n_cells[dim], long extent[dim])
+    {
+      for (int d = 0; d < dim; ++d)
+        extent[d] = n_cells[d];
+    }
   } // namespace
 
   template <int dim>
@@ -176,25 +269,45 @@ namespace mpm
       }
     // colorize: boundary ids 0..2dim-1 for x min, x max, y min, ...; children inherit them.
     dealii::GridGenerator::subdivided_hyper_rectangle(triangulation, repetitions, p1, p2, true);
+    coarse_cell_edge = k << levels;
+    for (unsigned int d = 0; d < dim; ++d)
+      coarse_cells_along[d] = static_cast<int>(repetitions[d]);
+    coarse_cells.resize(triangulation.n_cells(0));
+    for (const auto &cell : triangulation.cell_iterators_on_level(0))
+      {
+        long first[dim], place = 0;
+        lower_lattice_corner(cell, first);
+        for (int d = dim - 1; d >= 0; --d)
+          place = place * coarse_cells_along[d] + first[d] / coarse_cell_edge;
+        coarse_cells[place] = cell;
+      }
     // Several ranks: p4est partitions the refined cells by the start points' work (the
     // partition after refine_global; Parallel/Load balance threshold 0 leaves it by cells).
-    // Counted per lattice cell in a plain array: the grid keeps per-lattice-cell arrays anyway
-    // (cell_of_lattice_cell), and a hash map took seconds for P1's 25.7M points.
+    // Counted per lattice cell of the box around the points in a plain array (a hash map took
+    // seconds for P1's 25.7M points), not over the lattice: the box may be mostly empty.
     boost::signals2::scoped_connection weights;
+    LatticeBox<dim>                    points_box;
     std::vector<unsigned int>          points_in_cell;
     if (distributed != nullptr && !start_points.empty() && parameters.load_balance_threshold > 0)
       {
-        long n_lattice_cells = 1;
-        for (unsigned int d = 0; d < dim; ++d)
-          n_lattice_cells *= n_cells[d];
-        points_in_cell.assign(n_lattice_cells, 0);
+        long cells[dim];
+        cell_extent<dim>(n_cells, cells);
         for (const HostPoints<dim, double> *points : start_points)
           for (int i = 0; i < points->size(); ++i)
             {
               double x[dim];
               for (int d = 0; d < dim; ++d)
                 x[d] = points->position[d][i];
-              ++points_in_cell[lattice_cell_of(x)];
+              points_box.add(lattice_cell_of(x), cells);
+            }
+        points_in_cell.assign(points_box.size(), 0);
+        for (const HostPoints<dim, double> *points : start_points)
+          for (int i = 0; i < points->size(); ++i)
+            {
+              double x[dim];
+              for (int d = 0; d < dim; ++d)
+                x[d] = points->position[d][i];
+              ++points_in_cell[points_box.index(lattice_cell_of(x), cells)];
             }
         const double       point_weight  = parameters.point_weight;
         const bool         empty_cost    = empty_cells_cost(parameters);
@@ -211,7 +324,7 @@ namespace mpm
         // p4est's int weights). Every child given the lattice cell at the parent's centre, as
         // before, left the build's partition unlike the repartition's (doc/log.md, 2026-12-02).
         weights = triangulation.signals.weight.connect(
-          [&points_in_cell, point_weight, empty_cost, lattice_cells, this, parent = std::pair<int, int>(-1, -1),
+          [&points_in_cell, &points_box, point_weight, empty_cost, lattice_cells, this, parent = std::pair<int, int>(-1, -1),
            next_child = 0u](
             const CellIterator &cell, const CellStatus status) mutable -> unsigned int {
             constexpr unsigned int last_vertex = dealii::GeometryInfo<dim>::vertices_per_cell - 1;
@@ -238,8 +351,14 @@ namespace mpm
                 count[d] = std::max(1L, std::lround((upper[d] - lower[d]) / h));
                 n *= count[d];
               }
-            double points = 0;
-            for_each_lattice_cell_in_box(first, count, [&](const long index) { points += points_in_cell[index]; });
+            double points = 0; // (the lattice cells outside the points' box hold none)
+            if (points_box.clip(first, count))
+              {
+                long cells[dim];
+                cell_extent<dim>(n_cells, cells);
+                for_each_lattice_cell_in_box(first, count,
+                                             [&](const long index) { points += points_in_cell[points_box.index(index, cells)]; });
+              }
             // A deal.II cell's weight: k^dim times that mean.
             return cell_partition_weight(points * lattice_cells / n, point_weight, lattice_cells, empty_cost);
           });
@@ -262,37 +381,36 @@ namespace mpm
   template <int dim>
   void BackgroundGrid<dim>::distribute_nodes()
   {
-    long n_lattice_cells = 1, n_lattice_nodes = 1;
-    for (unsigned int d = 0; d < dim; ++d)
-      {
-        n_lattice_cells *= n_cells[d];
-        n_lattice_nodes *= n_cells[d] + 1;
-      }
+    long lattice_cells[dim];
+    cell_extent<dim>(n_cells, lattice_cells);
     const int k  = cells_per_grid_cell;
     const int kd = lattice_cells_per_grid_cell;
 
     dof_handler.distribute_dofs(fe);
     locally_owned_dofs = dof_handler.locally_owned_dofs();
 
-    // The lattice cells: 1 in an owned deal.II cell, 2 in the one layer around those
-    // (corners included; for k = 1 p4est's ghost cells), 0 elsewhere.
-    std::vector<std::uint8_t> cell_state(n_lattice_cells, 0);
-    cell_of_lattice_cell.assign(n_lattice_cells, triangulation.end());
+    // The lattice cells: 1 in an owned fine deal.II cell, 2 in the one layer around those
+    // (corners included; for k = 1 p4est's ghost cells), 0 elsewhere; kept over the box of
+    // the owned fine cells and that layer.
+    LatticeBox<dim> state_box;
     for (const auto &cell : triangulation.active_cell_iterators())
       if (cell->is_locally_owned() && is_fine(cell))
-        for_each_lattice_cell(cell, [&](const long c) {
-          cell_state[c]           = 1;
-          cell_of_lattice_cell[c] = cell;
-        });
-      else if (cell->is_locally_owned()) // coarse, away from the material: no nodes
-        for_each_covered_lattice_cell(cell, [&](const long c) { cell_of_lattice_cell[c] = cell; });
-    auto cell_coordinates = [&](long index, long idx[dim]) {
-      for (int d = 0; d < dim; ++d)
-        {
-          idx[d] = index % n_cells[d];
-          index /= n_cells[d];
-        }
+        for_each_lattice_cell(cell, [&](const long c) { state_box.add(c, lattice_cells); });
+    state_box.grow(1, lattice_cells);
+    std::vector<std::uint8_t> cell_states(state_box.size(), 0);
+    auto                      cell_state = [&](const long c) -> std::uint8_t {
+      const long in_box = state_box.index(c, lattice_cells);
+      return in_box < 0 ? 0 : cell_states[in_box];
     };
+    auto set_cell_state = [&](const long c, const std::uint8_t state) {
+      const long in_box = state_box.index(c, lattice_cells);
+      AssertThrow(in_box >= 0, dealii::ExcInternalError()); // the box holds the owned cells and their layer
+      cell_states[in_box] = state;
+    };
+    for (const auto &cell : triangulation.active_cell_iterators())
+      if (cell->is_locally_owned() && is_fine(cell))
+        for_each_lattice_cell(cell, [&](const long c) { set_cell_state(c, 1); });
+    auto cell_coordinates = [&](long index, long idx[dim]) { LatticeBox<dim>::coordinates(index, lattice_cells, idx); };
     // Some lattice cell among the 3^dim around cell `idx` (offset -1..1) or the 2^dim around
     // node `idx` (offset -1..0) that is owned (only_owned) or owned or in the layer.
     auto any_around = [&](const long idx[dim], const bool of_node, const bool only_owned) {
@@ -309,7 +427,7 @@ namespace mpm
               in    = in && i >= 0 && i < n_cells[d];
               index = index * n_cells[d] + (in ? i : 0);
             }
-          if (in && (only_owned ? cell_state[index] == 1 : cell_state[index] != 0))
+          if (in && (only_owned ? cell_state(index) == 1 : cell_state(index) != 0))
             return true;
         }
       return false;
@@ -320,7 +438,7 @@ namespace mpm
           long idx[dim];
           cell_coordinates(c, idx);
           if (any_around(idx, false, true)) // not the cells of the layer marked so far
-            cell_state[c] = 2;
+            set_cell_state(c, 2);
         });
 
     // The locally relevant nodes: every DoF of an owned cell, and those of the ghost cells
@@ -328,21 +446,18 @@ namespace mpm
     // locally relevant DoFs). A DoF's lattice node is its support point's.
     const std::vector<dealii::Point<dim>>        &unit = fe.get_unit_support_points();
     std::vector<dealii::types::global_dof_index> dofs(fe.n_dofs_per_cell());
-    // Calls f(DoF, lattice node) for each relevant DoF of non-artificial cell `cell`.
+    // Calls f(DoF, lattice node coordinates) for each relevant DoF of non-artificial cell `cell`.
     auto for_each_relevant_dof = [&](const auto &cell, const auto &f) {
       cell->get_dof_indices(dofs);
       long first[dim];
       lower_lattice_corner(cell, first);
       for (unsigned int i = 0; i < dofs.size(); ++i)
         {
-          long idx[dim], node = 0;
-          for (int d = dim - 1; d >= 0; --d)
-            {
-              idx[d] = first[d] + std::lround(unit[i][d] * k);
-              node   = node * (n_cells[d] + 1) + idx[d];
-            }
+          long idx[dim];
+          for (int d = 0; d < dim; ++d)
+            idx[d] = first[d] + std::lround(unit[i][d] * k);
           if (k == 1 || cell->is_locally_owned() || any_around(idx, true, false))
-            f(dofs[i], node);
+            f(dofs[i], idx);
         }
     };
     if (k == 1)
@@ -353,7 +468,7 @@ namespace mpm
         std::vector<dealii::types::global_dof_index> layer;
         for (const auto &cell : dof_handler.active_cell_iterators())
           if (cell->is_ghost() && is_fine(cell))
-            for_each_relevant_dof(cell, [&](const auto dof, long) { layer.push_back(dof); });
+            for_each_relevant_dof(cell, [&](const auto dof, const long *) { layer.push_back(dof); });
         std::sort(layer.begin(), layer.end());
         layer.erase(std::unique(layer.begin(), layer.end()), layer.end());
         locally_relevant_dofs.add_indices(layer.begin(), layer.end());
@@ -369,11 +484,22 @@ namespace mpm
       }
 
     const unsigned int n_local_nodes = partitioner->locally_owned_size() + partitioner->n_ghost_indices();
-    auto               node_map      = std::make_shared<std::vector<int>>(n_lattice_nodes, -1);
+    // The lookup over the box of the rank's nodes (a coarse cell's DoFs are no lattice nodes).
+    LatticeBox<dim> node_box;
     for (const auto &cell : dof_handler.active_cell_iterators())
-      if (!cell->is_artificial() && is_fine(cell)) // a coarse cell's DoFs are no lattice nodes
-        for_each_relevant_dof(cell, [&](const auto dof, const long node) {
-          (*node_map)[node] = static_cast<int>(partitioner->global_to_local(dof));
+      if (!cell->is_artificial() && is_fine(cell))
+        for_each_relevant_dof(cell, [&](const auto, const long *idx) { node_box.add_at(idx); });
+    auto node_map = std::make_shared<LatticeNodeMap<dim>>();
+    for (unsigned int d = 0; d < dim; ++d)
+      {
+        node_map->lower[d] = node_box.along(d) > 0 ? static_cast<int>(node_box.lower[d]) : 0;
+        node_map->nodes[d] = static_cast<int>(node_box.along(d));
+      }
+    node_map->local.assign(node_box.size(), -1);
+    for (const auto &cell : dof_handler.active_cell_iterators())
+      if (!cell->is_artificial() && is_fine(cell))
+        for_each_relevant_dof(cell, [&](const auto dof, const long *idx) {
+          node_map->local[node_box.index_at(idx)] = static_cast<int>(partitioner->global_to_local(dof));
         });
     lattice_to_node = node_map;
     fixed_components.assign(n_local_nodes, 0);
@@ -427,7 +553,7 @@ namespace mpm
         {
           int s = 0;
           for_each_lattice_cell(cell, [&](const long c) {
-            if (cell_state[c] == 2)
+            if (cell_state(c) == 2)
               ghost_cells.push_back(cell->global_active_cell_index() * kd + s);
             ++s;
           });
@@ -451,24 +577,11 @@ namespace mpm
           int s = 0;
           for_each_lattice_cell(cell, [&](const long c) {
             const dealii::types::global_cell_index global = cell->global_active_cell_index() * kd + s++;
-            if (cell_state[c] != 0)
+            if (cell_state(c) != 0)
               lattice_cell_of_local_cell_index[cells->global_to_local(global)] = c;
           });
         }
     cell_partitioner = cells;
-  }
-
-  template <int dim>
-  template <typename F>
-  void BackgroundGrid<dim>::for_each_covered_lattice_cell(const typename dealii::Triangulation<dim>::cell_iterator &cell,
-                                                          F f) const
-  {
-    long first[dim], count[dim];
-    lower_lattice_corner(cell, first);
-    const dealii::Point<dim> upper = cell->vertex(dealii::GeometryInfo<dim>::vertices_per_cell - 1);
-    for (int d = 0; d < dim; ++d)
-      count[d] = std::lround((upper[d] - origin[d]) / h) - first[d];
-    for_each_lattice_cell_in_box(first, count, f);
   }
 
   template <int dim>
@@ -596,7 +709,30 @@ namespace mpm
   template <int dim>
   typename dealii::Triangulation<dim>::active_cell_iterator BackgroundGrid<dim>::owned_cell(const long c) const
   {
-    return cell_of_lattice_cell[c];
+    long cells[dim], idx[dim], place = 0;
+    cell_extent<dim>(n_cells, cells);
+    LatticeBox<dim>::coordinates(c, cells, idx);
+    for (int d = dim - 1; d >= 0; --d)
+      place = place * coarse_cells_along[d] + idx[d] / coarse_cell_edge;
+    // Down from the coarse cell: child j is the corner with bit d of j set for the upper half
+    // along d (deal.II's numbering of a hypercube's children).
+    typename dealii::Triangulation<dim>::cell_iterator cell = coarse_cells[place];
+    long                                               first[dim];
+    for (int d = 0; d < dim; ++d)
+      first[d] = idx[d] / coarse_cell_edge * coarse_cell_edge;
+    for (long edge = coarse_cell_edge; cell->has_children(); edge /= 2)
+      {
+        unsigned int child = 0;
+        for (int d = 0; d < dim; ++d)
+          if (idx[d] - first[d] >= edge / 2)
+            {
+              child |= 1u << d;
+              first[d] += edge / 2;
+            }
+        cell = cell->child(child);
+      }
+    return cell->is_locally_owned() ? typename dealii::Triangulation<dim>::active_cell_iterator(cell) :
+                                      triangulation.end();
   }
 
   template <int dim>
@@ -643,7 +779,12 @@ namespace mpm
         v.velocity[d] = velocity[d].begin();
       }
     v.h                = h;
-    v.lattice_to_node  = lattice_to_node->data();
+    v.lattice_to_node  = lattice_to_node->local.data();
+    for (unsigned int d = 0; d < dim; ++d)
+      {
+        v.box_lower[d] = lattice_to_node->lower[d];
+        v.box_nodes[d] = lattice_to_node->nodes[d];
+      }
     v.n_nodes          = static_cast<int>(fixed_components.size());
     v.mass             = mass.begin();
     v.fixed_components = fixed_components.data();

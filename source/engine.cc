@@ -221,8 +221,8 @@ namespace mpm
         std::vector<int>    before = std::move(listed_nodes);
         listed_nodes.clear();
         for (const long lattice : chooser->nodes().lattice_of_node)
-          if (lattice >= 0 && g.lattice_to_node[lattice] >= 0)
-            listed_nodes.push_back(g.lattice_to_node[lattice]);
+          if (const int node = lattice >= 0 ? g.node_of_lattice(lattice) : -1; node >= 0)
+            listed_nodes.push_back(node);
         std::sort(listed_nodes.begin(), listed_nodes.end());
         if (same) // the arrays hold the last steps' values: zero the nodes left out now
           {
@@ -317,7 +317,7 @@ namespace mpm
             const long lattice = this->follows_material() ? lattice_of_kept_node()[l] : l;
             if (lattice < 0) // a kept block's node beyond the lattice
               continue;
-            const int node = to.lattice_to_node[lattice];
+            const int node = to.node_of_lattice(lattice);
             to.mass[node]  = own_nodes.mass[l];
             for (int d = 0; d < dim; ++d)
               to.velocity[d][node] = own_nodes.velocity[d][l];
@@ -402,6 +402,11 @@ namespace mpm
               }
             g = make_grid_view<dim, Real>(own_nodes);
             g.lattice_to_node  = grid.lattice_to_node;
+            for (int d = 0; d < dim; ++d)
+              {
+                g.box_lower[d] = grid.box_lower[d];
+                g.box_nodes[d] = grid.box_nodes[d];
+              }
             g.n_nodes          = grid.n_nodes;
             g.fixed_components = grid.fixed_components;
             g.friction_faces   = grid.friction_faces;

@@ -381,16 +381,34 @@ namespace mpm
     // and table entry per block (5 bytes per B^dim cells) and the kept nodes, about four
     // times the cells the bodies fill (the material spreads, and a block's neighbours are
     // kept) at the engine's nodal arrays, cell sums, numbering and grid output (500 bytes).
+    double material_cells = 0;
+    for (const BodyParameters &body : p.bodies)
+      material_cells += points_of_body(body, p) / std::pow(body.points_per_direction, dim);
+    const double n_blocks = e.n_cells / std::pow(p.active_block_cells, dim);
+    double      &per_rank_grid_bytes = e.per_rank_grid_bytes;
     if (p.active_block_cells > 0 && n_ranks == 1)
+      e.grid_bytes = 5 * n_blocks + 500 * std::min(e.n_cells, 4 * material_cells);
+    // Near the material on several ranks (CPU): deal.II's grid fine only near the material (a
+    // cell's bytes for about four times the cells the bodies fill, as above), and on every rank
+    // the coarse grid (cells of 2^L x k lattice cells, BackgroundGrid) and the blocks' marks and
+    // tables (about 10 bytes a block); the lookups span only a rank's own cells.
+    else if (p.active_block_cells > 0 && p.backend == "cpu")
       {
-        double material_cells = 0;
-        for (const BodyParameters &body : p.bodies)
-          material_cells += points_of_body(body, p) / std::pow(body.points_per_direction, dim);
-        e.grid_bytes = 5 * e.n_cells / std::pow(p.active_block_cells, dim) +
-                       500 * std::min(e.n_cells, 4 * material_cells);
+        unsigned int levels = 10;
+        for (unsigned int d = 0; d < dim; ++d)
+          {
+            const long   cells_of_k = std::lround((p.upper[d] - p.lower[d]) / p.cell_size) / p.cells_per_grid_cell;
+            unsigned int twos       = 0;
+            while (twos < levels && cells_of_k > 0 && (cells_of_k >> twos) % 2 == 0)
+              ++twos;
+            levels = std::min(levels, twos);
+          }
+        const double coarse_cells = e.n_cells / std::pow(double(p.cells_per_grid_cell << levels), dim);
+        e.grid_bytes              = b.cell * std::min(e.n_cells, 4 * material_cells);
+        per_rank_grid_bytes       = 10 * n_blocks + b.cell * coarse_cells;
       }
     e.point_bytes    = b.point * e.n_points;
-    e.per_rank_bytes = b.program + b.generated_point * e.n_points + field_bytes;
+    e.per_rank_bytes = b.program + b.generated_point * e.n_points + field_bytes + per_rank_grid_bytes;
     return e;
   }
 
@@ -592,9 +610,11 @@ namespace mpm
       return;
 
     // Name what needs the most: the grid, a body's points, or a random field.
-    const double fields = e.per_rank_bytes - bytes_per(p.dim).generated_point * e.n_points - bytes_per(p.dim).program;
+    const double fields = e.per_rank_bytes - bytes_per(p.dim).generated_point * e.n_points - bytes_per(p.dim).program -
+                          e.per_rank_grid_bytes;
+    const double grid   = e.grid_bytes + n_ranks * e.per_rank_grid_bytes;
     std::string  entry  = "Grid/Cell size";
-    if (e.point_bytes > e.grid_bytes && e.point_bytes > fields && !p.bodies.empty())
+    if (e.point_bytes > grid && e.point_bytes > fields && !p.bodies.empty())
       {
         unsigned int largest = 0;
         for (unsigned int b = 1; b < p.bodies.size(); ++b)
@@ -602,13 +622,14 @@ namespace mpm
             largest = b;
         entry = "Material points/Body " + std::to_string(largest + 1) + "/Points per cell direction";
       }
-    else if (fields > e.grid_bytes && fields > e.point_bytes)
+    else if (fields > grid && fields > e.point_bytes)
       for (unsigned int m = 0; m < p.materials.size(); ++m)
         if (p.materials[m].field_parameter != FieldParameter::none)
           entry = "Material " + p.material_names[m] + "/Random field/Correlation lengths";
     std::string parts = number(e.n_cells) + " grid cells of " + number(p.cell_size) + " m (" +
-                        number(e.grid_bytes / GB) + " GB), " + number(e.n_points) + " material points (" +
-                        number((e.point_bytes + (e.per_rank_bytes - fields - bytes_per(p.dim).program) * n_ranks) / GB) +
+                        number(grid / GB) + " GB), " + number(e.n_points) + " material points (" +
+                        number((e.point_bytes + (e.per_rank_bytes - fields - bytes_per(p.dim).program -
+                                                 e.per_rank_grid_bytes) * n_ranks) / GB) +
                         " GB)";
     if (e.n_field_nodes > 0)
       parts += ", random fields of " + number(e.n_field_nodes) + " nodes (" + number(fields / GB) + " GB on each rank)";

@@ -168,10 +168,7 @@ namespace mpm
         lattice_to_node = grid.lattice_node_map();
         h               = grid.h;
         for (int d = 0; d < dim; ++d)
-          {
-            origin[d]          = grid.origin[d];
-            n_lattice_cells[d] = grid.n_cells[d];
-          }
+          origin[d] = grid.origin[d];
       }
     nodal.push_back(grid.mass);
     for (int d = 0; d < dim; ++d)
@@ -295,14 +292,13 @@ namespace mpm
             patch.data.reinit(n_nodal + 1, n_vertices);
             for (unsigned int v = 0; v < n_vertices; ++v)
               {
-                long node = 0;
-                for (int d = dim - 1; d >= 0; --d)
+                int node[dim];
+                for (int d = 0; d < dim; ++d)
                   {
-                    const int i          = first[d] + ((v >> d) & 1);
-                    patch.vertices[v][d] = snapshot.origin[d] + i * snapshot.h;
-                    node                 = node * (snapshot.n_lattice_cells[d] + 1) + i;
+                    node[d]              = first[d] + ((v >> d) & 1);
+                    patch.vertices[v][d] = snapshot.origin[d] + node[d] * snapshot.h;
                   }
-                const int local = (*snapshot.lattice_to_node)[node];
+                const int local = (*snapshot.lattice_to_node)(node);
                 for (unsigned int f = 0; f < n_nodal; ++f)
                   patch.data(f, v) = snapshot.nodal[f].local_element(local);
                 patch.data(n_nodal, v) = snapshot.rank;

@@ -86,7 +86,7 @@ namespace
     std::vector<long>                 count_of_mask(1u << dim, 0);
     for (long l = 0; l < n; ++l)
       {
-        const std::uint8_t expected = g.fixed_components[g.lattice_to_node[l]];
+        const std::uint8_t expected = g.fixed_components[g.node_of_lattice(l)];
         differ += lattice.fixed_components[l] != expected;
         constrained += expected != 0;
         ++count_of_mask[expected];
@@ -98,7 +98,7 @@ namespace
     const bool both = !lattice.friction_faces.empty() && g.friction_faces != nullptr;
     for (long l = 0; both && l < n; ++l)
       {
-        const std::uint8_t expected = g.friction_faces[g.lattice_to_node[l]];
+        const std::uint8_t expected = g.friction_faces[g.node_of_lattice(l)];
         differ_friction += lattice.friction_faces[l] != expected;
         on_friction_face += expected != 0;
       }

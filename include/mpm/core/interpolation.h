@@ -79,19 +79,19 @@ namespace mpm
   }
 
   // Strides (x fastest, as GridView::node) and the index of the stencil's first node in the
-  // numbering the grid computes nodes in: the lattice's (with a lookup) or its box's (without);
-  // returns whether the whole stencil of n nodes per direction lies inside the lattice or
-  // the box (then the node of stencil offset o is grid.node_at(base + o), with no bounds
-  // check per node). Through a block table a stencil's nodes are not one index plus
-  // offsets: false, and the callers ask GridView::node per node; base is then the lattice
-  // index, and *in_lattice (where given) whether the stencil lies inside the lattice.
+  // grid's box (GridView::node_in_box); returns whether the whole stencil of n nodes per
+  // direction lies inside the box (then the node of stencil offset o is
+  // grid.node_at(base + o), with no bounds check per node). Through a block table a
+  // stencil's nodes are not one index plus offsets: false, and the callers ask
+  // GridView::node per node; base is then the lattice index, and *in_lattice (where given)
+  // whether the stencil lies inside the lattice (elsewhere: inside the box).
   template <int dim, int n, typename Real>
   MPM_HOST_DEVICE inline bool stencil_base(const GridView<dim, Real> &grid, const int first[dim], long stride[dim],
                                            long &base, bool *in_lattice = nullptr)
   {
     bool inside = true;
     base        = 0;
-    if (grid.lattice_to_node != nullptr)
+    if (grid.lattice_to_node != nullptr && grid.block_cells > 0)
       {
         for (int d = 0; d < dim; ++d)
           {
@@ -101,16 +101,17 @@ namespace mpm
           }
         if (in_lattice != nullptr)
           *in_lattice = inside;
-        return inside && grid.block_cells == 0;
+        return false;
       }
-    else
-      for (int d = 0; d < dim; ++d)
-        {
-          stride[d]      = d == 0 ? 1 : stride[d - 1] * grid.box_nodes[d - 1];
-          const int from = first[d] - grid.box_lower[d];
-          base += from * stride[d];
-          inside = inside && from >= 0 && from + n <= grid.box_nodes[d];
-        }
+    for (int d = 0; d < dim; ++d)
+      {
+        stride[d]      = d == 0 ? 1 : stride[d - 1] * grid.box_nodes[d - 1];
+        const int from = first[d] - grid.box_lower[d];
+        base += from * stride[d];
+        inside = inside && from >= 0 && from + n <= grid.box_nodes[d];
+      }
+    if (in_lattice != nullptr)
+      *in_lattice = inside;
     return inside;
   }
 

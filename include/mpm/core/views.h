@@ -40,25 +40,27 @@ namespace mpm
   }
 
   // Uniform background lattice. Its nodes are numbered in one of three ways: through a
-  // lookup (deal.II's locally relevant DoF space); through a block table, one entry per
-  // block of nodes (the nodes near the material, active_nodes.h: memory that follows the
-  // material, not the lattice); or, with neither, as a box of the lattice in lattice order
-  // (device grids: the whole lattice, a rank's slab, the box around the material), whose
-  // index is computed, not looked up.
+  // lookup over a box of the lattice (deal.II's locally relevant DoF space: the box around
+  // a rank's nodes, so that its memory follows the rank's cells, not the lattice); through
+  // a block table, one entry per block of nodes (the nodes near the material,
+  // active_nodes.h: memory that follows the material, not the lattice); or, with neither,
+  // as a box of the lattice in lattice order (device grids: the whole lattice, a rank's
+  // slab, the box around the material), whose index is computed, not looked up.
   template <int dim, typename Real>
   struct GridView
   {
     Real origin[dim];           // lower corner of the grid
     Real h;                     // cell size, equal in every direction
     int  n_cells[dim];          // cells per direction
-    // Lattice index -> local node index, -1 if absent; with block_cells > 0 the block table
-    // instead (set_block_table). Null: the nodes are the box of lattice nodes box_lower[d] ..
-    // box_lower[d] + box_nodes[d] - 1 along each axis, x fastest, a lattice node outside the
-    // box absent. (The box is tested first and the table inside the lookup's branch, so that
-    // the dense grids' kernels carry no more than before.)
+    // The box of lattice nodes box_lower[d] .. box_lower[d] + box_nodes[d] - 1 along each
+    // axis, x fastest; a lattice node outside it is absent. Its index (node_in_box) -> local
+    // node index, -1 if absent; with block_cells > 0 the block table instead
+    // (set_block_table; no box). Null: the box's index is the local node index. (The box is
+    // tested first and the table inside the lookup's branch, so that the dense grids'
+    // kernels carry no more than before.)
     const int *lattice_to_node;
     int        n_nodes;             // local nodes (length of the arrays below)
-    int        box_lower[dim] = {}; // without a lookup: the box's first lattice node
+    int        box_lower[dim] = {}; // the box's first lattice node
     int        box_nodes[dim] = {}; // and its nodes along each axis (inside the lattice)
     int        block_cells      = 0;  // > 0: lattice_to_node is a block table of blocks of B nodes per axis
     int        node_blocks[dim] = {}; // its node blocks along each axis
@@ -128,18 +130,12 @@ namespace mpm
         return node_in_box(idx);
       if (block_cells > 0)
         return node_in_blocks(idx);
-      long lattice = 0;
-      for (int d = dim - 1; d >= 0; --d)
-        {
-          if (idx[d] < 0 || idx[d] > n_cells[d])
-            return -1;
-          lattice = lattice * (n_cells[d] + 1) + idx[d];
-        }
-      return lattice_to_node[lattice];
+      const int in_box = node_in_box(idx);
+      return in_box < 0 ? -1 : lattice_to_node[in_box];
     }
 
-    // Without a lookup: the box's node (i,j,k), -1 outside the box (the box lies inside the
-    // lattice, so this covers the lattice's ends too).
+    // The box's index of node (i,j,k) (without a lookup the node itself), -1 outside the box
+    // (the box lies inside the lattice, so this covers the lattice's ends too).
     MPM_HOST_DEVICE int node_in_box(const int idx[dim]) const
     {
       long node = 0;
@@ -185,21 +181,19 @@ namespace mpm
     // Local node index of a lattice index inside the lattice (-1: absent).
     MPM_HOST_DEVICE int node_of_lattice(const long lattice) const
     {
-      if (lattice_to_node != nullptr && block_cells == 0)
-        return lattice_to_node[lattice];
       int idx[dim];
       lattice_node_coordinates<dim>(n_cells, lattice, idx);
-      return lattice_to_node != nullptr ? node_in_blocks(idx) : node_in_box(idx);
+      return node(idx);
     }
 
-    // The node at an index computed by stencil_base (interpolation.h): the lattice index
-    // through the lookup, or the box's node index itself.
+    // The node at a box index computed by stencil_base (interpolation.h): through the
+    // lookup, or the box's index itself.
     MPM_HOST_DEVICE int node_at(const long index) const
     {
       return lattice_to_node != nullptr ? lattice_to_node[index] : static_cast<int>(index);
     }
 
-    // Without a lookup, the box of the whole lattice.
+    // The box of the whole lattice.
     MPM_HOST_DEVICE void box_is_lattice()
     {
       for (int d = 0; d < dim; ++d)

@@ -35,6 +35,30 @@
 
 namespace mpm
 {
+  // Local node index of the lattice nodes of a box of the lattice (the box around a rank's
+  // nodes, so that the lookup takes memory for the rank's cells, not for the lattice): the
+  // lookup of GridView (views.h), -1 where the rank holds no node.
+  template <int dim>
+  struct LatticeNodeMap
+  {
+    int              lower[dim] = {}; // the box's first lattice node
+    int              nodes[dim] = {}; // its nodes along each axis
+    std::vector<int> local;           // by the box's index, x fastest
+    // The node at lattice node coordinates idx (-1: outside the box or absent).
+    int operator()(const int idx[dim]) const
+    {
+      long index = 0;
+      for (int d = dim - 1; d >= 0; --d)
+        {
+          const int i = idx[d] - lower[d];
+          if (i < 0 || i >= nodes[d])
+            return -1;
+          index = index * nodes[d] + i;
+        }
+      return local[index];
+    }
+  };
+
   // The lattice of the background grid from the prm alone: origin, cell size and cells
   // per direction, no nodal arrays (point generation needs no more, before the grid exists).
   template <int dim>
@@ -116,9 +140,9 @@ namespace mpm
       return cell->level() == finest_level;
     }
 
-    // Active cell of the triangulation at lattice cell index i + n_x (j + n_y k),
-    // or triangulation.end() where this rank does not own the cell (a coarse cell away from
-    // the material: the cell that holds it).
+    // Active cell of the triangulation at lattice cell index i + n_x (j + n_y k) (at any
+    // level: a coarse cell away from the material holds many), or triangulation.end() where
+    // this rank does not own that cell.
     typename dealii::Triangulation<dim>::active_cell_iterator owned_cell(long lattice_cell) const;
 
     // Lattice cell index of the cell containing x (clamped to the grid).
@@ -221,9 +245,10 @@ namespace mpm
     // triangulation's partitioner of global active cell indices.
     std::shared_ptr<const dealii::Utilities::MPI::Partitioner> cell_partitioner;
 
-    // Local node index of each lattice node (-1 where this rank holds none). Replaced, not
-    // changed, when the nodes are distributed again: an output being written keeps its own.
-    std::shared_ptr<const std::vector<int>> lattice_node_map() const { return lattice_to_node; }
+    // Local node index of each lattice node around this rank's (-1 where it holds none).
+    // Replaced, not changed, when the nodes are distributed again: an output being written
+    // keeps its own.
+    std::shared_ptr<const LatticeNodeMap<dim>> lattice_node_map() const { return lattice_to_node; }
 
   private:
     template <typename Real>
@@ -243,20 +268,22 @@ namespace mpm
     void lower_lattice_corner(const typename dealii::Triangulation<dim>::cell_iterator &cell, long first[dim]) const;
 
     std::array<BoundaryType, 6> boundary;
-    std::shared_ptr<std::vector<int>> lattice_to_node;
+    std::shared_ptr<LatticeNodeMap<dim>> lattice_to_node;
     std::vector<std::uint8_t> fixed_components;
     std::vector<std::uint8_t> friction_faces;            // empty without a friction face
     double                    friction_coefficient[6] = {}; // by boundary id
-    std::vector<typename dealii::Triangulation<dim>::active_cell_iterator> cell_of_lattice_cell;
+    // The coarse grid's cells by their place along each axis, x fastest, and their edge in
+    // lattice cells: owned_cell descends from them (no table per lattice cell).
+    std::vector<typename dealii::Triangulation<dim>::cell_iterator> coarse_cells;
+    int                                                             coarse_cell_edge = 0;
+    int                                                             coarse_cells_along[dim] = {};
 
     // Coarse away from the material: the block edge (0: the grid is uniform) and the fine
     // region, one byte per cell block.
     int                        fine_block_cells = 0;
     std::vector<unsigned char> fine_blocks;
-    // Calls f(lattice cell) for every lattice cell that `cell` covers (at any level), and for
-    // those of the box of count[d] cells from lattice cell first[d] along each axis.
-    template <typename F>
-    void for_each_covered_lattice_cell(const typename dealii::Triangulation<dim>::cell_iterator &cell, F f) const;
+    // Calls f(lattice cell) for the lattice cells of the box of count[d] cells from lattice
+    // cell first[d] along each axis.
     template <typename F>
     void for_each_lattice_cell_in_box(const long first[dim], const long count[dim], F &&f) const;
     // Whether `cell` covers a lattice cell of a block flagged in blocks.

@@ -79,7 +79,8 @@ namespace mpm
     double n_cells = 0, n_nodes = 0, n_points = 0, n_field_nodes = 0;
     double grid_bytes  = 0; // deal.II's grid, DoFs and vectors, the engine's nodes: shared by the ranks
     double point_bytes = 0; // the handler's and the engine's points, output copies: shared by the ranks
-    double per_rank_bytes = 0; // on every rank: the generated bodies, the random fields
+    double per_rank_bytes = 0; // on every rank: the generated bodies, the random fields, per_rank_grid_bytes
+    double per_rank_grid_bytes = 0; // on every rank: the coarse grid and block tables (near the material, CPU ranks)
     // The whole run on n ranks, and what one rank needs.
     double total(const unsigned int n_ranks) const { return grid_bytes + point_bytes + n_ranks * per_rank_bytes; }
     double of_one_rank(const unsigned int n_ranks) const
@@ -88,7 +89,8 @@ namespace mpm
     }
   };
   // n_points < 0: the points of the prm's bodies, counted from their volumes and point spacing.
-  // With Grid/Nodes = near material on one rank the grid costs what the kept nodes do.
+  // With Grid/Nodes = near material on one rank, or on several CPU ranks, the grid costs what
+  // the cells near the material do, plus a few bytes per block of the box.
   MemoryEstimate estimate_memory(const Parameters &parameters, double n_points = -1, unsigned int n_ranks = 1);
 
   // Refuses, on every rank of `communicator` alike, a run whose estimate exceeds Resources/

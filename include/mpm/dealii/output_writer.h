@@ -81,10 +81,9 @@ namespace mpm
     float                                                                rank = 0;
     // Grid/Cells per deal.II cell k > 1: a patch per lattice cell of each deal.II cell, its
     // vertices' values found through the grid's lattice lookup of the snapshot's time.
-    int                                     cells_per_grid_cell = 1;
-    std::shared_ptr<const std::vector<int>> lattice_to_node;
-    double                                  origin[dim] = {}, h = 0;
-    int                                     n_lattice_cells[dim] = {};
+    int                                        cells_per_grid_cell = 1;
+    std::shared_ptr<const LatticeNodeMap<dim>> lattice_to_node;
+    double                                     origin[dim] = {}, h = 0;
 
     int n_cells() const
     {
