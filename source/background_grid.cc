@@ -195,15 +195,16 @@ namespace mpm
     return !(parameters.active_block_cells > 0 && parameters.backend == "cpu");
   }
 
-  void flag_blocks_of_every_rank(std::vector<unsigned char> &blocks, const int block_cells, MPI_Comm communicator)
+  std::vector<long> blocks_of_every_rank(std::vector<long> own, MPI_Comm communicator)
   {
-    AssertThrow(blocks.size() <= static_cast<std::size_t>(std::numeric_limits<int>::max()),
-                dealii::ExcMessage("Grid/Active block size = " + std::to_string(block_cells) + ": the grid has "
-                                   "more blocks than one MPI message can count on several ranks. Allowed values "
-                                   "are 1 to 64: choose a larger block size."));
-    const int mpi_error = MPI_Allreduce(MPI_IN_PLACE, blocks.data(), static_cast<int>(blocks.size()),
-                                        MPI_UNSIGNED_CHAR, MPI_MAX, communicator);
-    AssertThrowMPI(mpi_error);
+    std::sort(own.begin(), own.end());
+    own.erase(std::unique(own.begin(), own.end()), own.end());
+    std::vector<long> all;
+    for (const std::vector<long> &of_rank : dealii::Utilities::MPI::all_gather(communicator, own))
+      all.insert(all.end(), of_rank.begin(), of_rank.end());
+    std::sort(all.begin(), all.end());
+    all.erase(std::unique(all.begin(), all.end()), all.end());
+    return all;
   }
 
   template <int dim>
@@ -256,15 +257,20 @@ namespace mpm
       {
         fine_block_cells = parameters.active_block_cells;
         fine_blocks.assign(mpm::n_blocks<dim>(n_cells, fine_block_cells), 0);
-        std::vector<unsigned char> holding(fine_blocks.size(), 0);
+        std::fill(fine_region_lower, fine_region_lower + dim, std::numeric_limits<long>::max());
+        std::fill(fine_region_upper, fine_region_upper + dim, -1L);
+        std::vector<long> holding;
         for (const HostPoints<dim, double> *points : start_points)
           for (int i = 0; i < points->size(); ++i)
             {
               double x[dim];
               for (int d = 0; d < dim; ++d)
                 x[d] = points->position[d][i];
-              holding[block_of(x)] = 1;
+              if (const long b = block_of(x); holding.empty() || holding.back() != b)
+                holding.push_back(b);
             }
+        std::sort(holding.begin(), holding.end());
+        holding.erase(std::unique(holding.begin(), holding.end()), holding.end());
         fine_region_misses(holding);
       }
     // colorize: boundary ids 0..2dim-1 for x min, x max, y min, ...; children inherit them.
@@ -606,8 +612,7 @@ namespace mpm
   }
 
   template <int dim>
-  bool BackgroundGrid<dim>::meets_blocks(const typename dealii::Triangulation<dim>::cell_iterator &cell,
-                                         const std::vector<unsigned char>                    &blocks) const
+  bool BackgroundGrid<dim>::meets_fine_region(const typename dealii::Triangulation<dim>::cell_iterator &cell) const
   {
     const int B = fine_block_cells;
     long      first[dim], lo[dim], hi[dim], nb[dim], n = 1;
@@ -615,8 +620,10 @@ namespace mpm
     const dealii::Point<dim> upper = cell->vertex(dealii::GeometryInfo<dim>::vertices_per_cell - 1);
     for (int d = 0; d < dim; ++d)
       {
-        lo[d] = first[d] / B;
-        hi[d] = (std::lround((upper[d] - origin[d]) / h) - 1) / B;
+        lo[d] = std::max(first[d] / B, fine_region_lower[d]);
+        hi[d] = std::min((std::lround((upper[d] - origin[d]) / h) - 1) / B, fine_region_upper[d]);
+        if (lo[d] > hi[d])
+          return false;
         nb[d] = n_blocks_along<dim>(n_cells[d], B);
         n *= hi[d] - lo[d] + 1;
       }
@@ -630,7 +637,7 @@ namespace mpm
           }
         for (int d = dim - 1; d >= 0; --d)
           block = block * nb[d] + at[d];
-        if (blocks[block] != 0)
+        if (fine_blocks[block] != 0)
           return true;
       }
     return false;
@@ -643,53 +650,59 @@ namespace mpm
   }
 
   template <int dim>
-  bool BackgroundGrid<dim>::fine_region_misses(const std::vector<unsigned char> &holding)
+  bool BackgroundGrid<dim>::fine_region_misses(const std::vector<long> &holding)
   {
     const int B = fine_block_cells;
     long      nb[dim];
     for (int d = 0; d < dim; ++d)
       nb[d] = n_blocks_along<dim>(n_cells[d], B);
-    // The blocks within `reach` blocks (max-norm) of a flagged one.
+    // The blocks within `reach` blocks (max-norm) of one in holding, ascending.
     const auto dilated = [&](const int reach) {
-      std::vector<unsigned char> out(holding.size(), 0);
-      const int width = 2 * reach + 1;
-      for (long b = 0; b < static_cast<long>(holding.size()); ++b)
-        if (holding[b] != 0)
-          {
-            long at[dim], rest = b;
-            for (int d = 0; d < dim; ++d)
-              {
-                at[d] = rest % nb[d];
-                rest /= nb[d];
-              }
-            for (int j = 0; j < dealii::Utilities::pow(width, dim); ++j)
-              {
-                long neighbour = 0;
-                bool inside    = true;
-                for (int d = dim - 1, r = j; d >= 0; --d)
-                  {
-                    const int  step = dealii::Utilities::pow(width, d);
-                    const long i    = at[d] - reach + r / step;
-                    r %= step;
-                    inside    = inside && i >= 0 && i < nb[d];
-                    neighbour = neighbour * nb[d] + (inside ? i : 0);
-                  }
-                if (inside)
-                  out[neighbour] = 1;
-              }
-          }
+      std::vector<long> out;
+      const int         width = 2 * reach + 1;
+      for (const long b : holding)
+        {
+          long at[dim], rest = b;
+          for (int d = 0; d < dim; ++d)
+            {
+              at[d] = rest % nb[d];
+              rest /= nb[d];
+            }
+          for (int j = 0; j < dealii::Utilities::pow(width, dim); ++j)
+            {
+              long neighbour = 0;
+              bool inside    = true;
+              for (int d = dim - 1, r = j; d >= 0; --d)
+                {
+                  const int  step = dealii::Utilities::pow(width, d);
+                  const long i    = at[d] - reach + r / step;
+                  r %= step;
+                  inside    = inside && i >= 0 && i < nb[d];
+                  neighbour = neighbour * nb[d] + (inside ? i : 0);
+                }
+              if (inside)
+                out.push_back(neighbour);
+            }
+        }
+      std::sort(out.begin(), out.end());
+      out.erase(std::unique(out.begin(), out.end()), out.end());
       return out;
     };
-    const std::vector<unsigned char> kept = dilated(1);
-    bool                             miss = false;
-    for (std::size_t b = 0; b < kept.size() && !miss; ++b)
-      miss = kept[b] != 0 && fine_blocks[b] == 0;
+    const std::vector<long> kept = dilated(1);
+    const bool miss = std::any_of(kept.begin(), kept.end(), [&](const long b) { return fine_blocks[b] == 0; });
     if (miss)
-      {
-        const std::vector<unsigned char> grown = dilated(2);
-        for (std::size_t b = 0; b < grown.size(); ++b)
-          fine_blocks[b] |= grown[b];
-      }
+      for (const long b : dilated(2))
+        {
+          fine_blocks[b] = 1;
+          long rest      = b;
+          for (int d = 0; d < dim; ++d)
+            {
+              const long at = rest % nb[d];
+              rest /= nb[d];
+              fine_region_lower[d] = std::min(fine_region_lower[d], at);
+              fine_region_upper[d] = std::max(fine_region_upper[d], at);
+            }
+        }
     return miss;
   }
 
@@ -698,7 +711,7 @@ namespace mpm
   {
     int flagged = 0;
     for (const auto &cell : triangulation.active_cell_iterators())
-      if (cell->is_locally_owned() && cell->level() < finest_level && meets_blocks(cell, fine_blocks))
+      if (cell->is_locally_owned() && cell->level() < finest_level && meets_fine_region(cell))
         {
           cell->set_refine_flag();
           flagged = 1;

@@ -199,21 +199,17 @@ namespace mpm
       // inside the margin. Collective: load() runs on every rank.
       void choose_listed_nodes()
       {
-        const int  B        = this->near_material.block_cells;
-        const long n_blocks = mpm::n_blocks<dim>(own_nodes.n_cells, B);
+        const int B = this->near_material.block_cells;
         AssertThrow(home_cells.size() == static_cast<std::size_t>(points.size()),
                     dealii::ExcMessage("Internal: the home cells are known only for points loaded from the "
                                        "ParticleHandler."));
-        std::vector<unsigned char> holding(n_blocks, 0);
-        const auto                 view = points.view();
+        std::vector<long> own; // (the points come by lattice cell: few repeats kept)
+        const auto        view = points.view();
         for (int i = 0; i < view.n_points; ++i)
-          if (view.material[i] >= 0)
-            holding[block_of_cell<dim>(home_cells[i], own_nodes.n_cells, B)] = 1;
-        flag_blocks_of_every_rank(holding, B, shared_grid->communicator);
-        std::vector<long> blocks;
-        for (long b = 0; b < n_blocks; ++b)
-          if (holding[b] != 0)
-            blocks.push_back(b);
+          if (const long b = block_of_cell<dim>(home_cells[i], own_nodes.n_cells, B);
+              view.material[i] >= 0 && (own.empty() || own.back() != b))
+            own.push_back(b);
+        const std::vector<long> blocks = blocks_of_every_rank(std::move(own), shared_grid->communicator);
         choose_nodes_near_material(B, [&]() { chooser->choose(blocks); });
 
         GridView<dim, Real> g      = shared_view(); // (float: its arrays made for a new partition)

@@ -391,7 +391,7 @@ namespace mpm
     // Near the material on several ranks (CPU): deal.II's grid fine only near the material (a
     // cell's bytes for about four times the cells the bodies fill, as above), and on every rank
     // the coarse grid (cells of 2^L x k lattice cells, BackgroundGrid) and the blocks' marks and
-    // tables (about 10 bytes a block); the lookups span only a rank's own cells.
+    // table (about 6 bytes a block); the lookups span only a rank's own cells.
     else if (p.active_block_cells > 0 && p.backend == "cpu")
       {
         unsigned int levels = 10;
@@ -405,7 +405,7 @@ namespace mpm
           }
         const double coarse_cells = e.n_cells / std::pow(double(p.cells_per_grid_cell << levels), dim);
         e.grid_bytes              = b.cell * std::min(e.n_cells, 4 * material_cells);
-        per_rank_grid_bytes       = 10 * n_blocks + b.cell * coarse_cells;
+        per_rank_grid_bytes       = 6 * n_blocks + b.cell * coarse_cells;
       }
     e.point_bytes    = b.point * e.n_points;
     e.per_rank_bytes = b.program + b.generated_point * e.n_points + field_bytes + per_rank_grid_bytes;

@@ -719,14 +719,14 @@ namespace mpm
   {
     if (!grid.coarse_away_from_material())
       return false;
-    std::vector<unsigned char> holding(grid.n_fine_blocks(), 0);
+    std::vector<long> own; // (the handler's points come cell by cell: few repeats kept)
     for (const auto &particle : handler)
       {
         const dealii::Point<dim> x = particle.get_location();
-        holding[grid.block_of(&x[0])] = 1;
+        if (const long b = grid.block_of(&x[0]); own.empty() || own.back() != b)
+          own.push_back(b);
       }
-    flag_blocks_of_every_rank(holding, grid.fine_block_size(), grid.communicator);
-    if (!grid.fine_region_misses(holding))
+    if (!grid.fine_region_misses(blocks_of_every_rank(std::move(own), grid.communicator)))
       return false;
     if (before_refining)
       before_refining();

@@ -196,7 +196,7 @@ namespace mpm
                       "than the memory its nodes would take). On several ranks (Backend = cpu) deal.II's grid is "
                       "fine only within two blocks of the points (coarse elsewhere, refined as they spread), the "
                       "step visits only the kept nodes, and the partition weighs only the cells with points; "
-                      "about 20 bytes per cell of the box remain on each rank (lookups). With Backend = cuda on "
+                      "nothing is kept per cell of the box (about 6 bytes per block). With Backend = cuda on "
                       "several ranks each rank keeps every node of its part of the grid.");
     prm.declare_entry("Active block size", "4", Patterns::Integer(1, 64),
                       "Nodes = near material: edge of the blocks, in cells. Every cell within this many cells "

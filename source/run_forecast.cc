@@ -72,7 +72,10 @@ namespace mpm
       out << ", " << number(e.of_one_rank(n_ranks) / GB, 3) << " GB on each of " << n_ranks << " ranks";
     out << " (deal.II's grid and the nodes " << number(e.grid_bytes / GB, 3) << " GB, the points "
         << number(e.point_bytes / GB, 3) << " GB, on every rank the program and the bodies' generation "
-        << number(e.per_rank_bytes / GB, 3) << " GB; doc/guards.md, \"The memory estimate\")\n";
+        << number((e.per_rank_bytes - e.per_rank_grid_bytes) / GB, 3) << " GB";
+    if (e.per_rank_grid_bytes > 0)
+      out << ", the coarse grid and the block tables " << number(e.per_rank_grid_bytes / GB, 3) << " GB";
+    out << "; doc/guards.md, \"The memory estimate\")\n";
     out << "  backend: " << p.backend << " in " << (p.single_precision ? "float" : "double") << ", " << n_ranks
         << " rank(s)" << std::endl;
   }

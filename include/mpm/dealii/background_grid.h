@@ -88,11 +88,11 @@ namespace mpm
   // box costs no step time; a partition by cells would leave the material to few ranks.
   bool empty_cells_cost(const Parameters &parameters);
 
-  // Several ranks, nodes near the material: block flags (one byte per block of block_cells^dim
-  // cells, 1 where this rank has a point) made the same on every rank, their maximum over the
-  // ranks of communicator (collective). Throws naming Grid/Active block size where the blocks
-  // are more than one MPI message can count.
-  void flag_blocks_of_every_rank(std::vector<unsigned char> &blocks, int block_cells, MPI_Comm communicator);
+  // Several ranks, nodes near the material: the blocks (of Active block size^dim cells) that
+  // hold a point on any rank of communicator, ascending, the same on every rank (collective):
+  // each rank's own (in any order, repeats allowed) gathered from every rank and merged, so
+  // that the messages and the work follow the material, not the box.
+  std::vector<long> blocks_of_every_rank(std::vector<long> own, MPI_Comm communicator);
 
   template <int dim>
   class BackgroundGrid
@@ -118,16 +118,14 @@ namespace mpm
     // every rank: the blocks within two blocks of one that holds a point (the nodes kept near
     // the material lie within one). The nodal arrays and lattice lookups cover the fine cells.
     bool coarse_away_from_material() const { return fine_block_cells > 0; }
-    // Whether the fine region misses a block within one block of those flagged in holding
-    // (one byte per block, the same on every rank); if so it is grown to every block within
+    // Whether the fine region misses a block within one block of those in holding (blocks
+    // that hold a point, the same on every rank); if so it is grown to every block within
     // two, and flag_cells_to_refine() then marks the cells to refine.
-    bool fine_region_misses(const std::vector<unsigned char> &holding);
+    bool fine_region_misses(const std::vector<long> &holding);
     // Sets the refine flag of every owned cell coarser than the full resolution that meets
     // the fine region; whether any rank flagged one (collective).
     bool flag_cells_to_refine();
-    // The cell blocks (of Active block size cells) of the lattice, and the block of a point.
-    long n_fine_blocks() const { return static_cast<long>(fine_blocks.size()); }
-    int  fine_block_size() const { return fine_block_cells; }
+    // The cell block (of Active block size cells) of a point.
     long block_of(const double *x) const;
     // Number of times the fine region grew after the grid was built.
     int n_refinements = 0;
@@ -286,9 +284,11 @@ namespace mpm
     // cell first[d] along each axis.
     template <typename F>
     void for_each_lattice_cell_in_box(const long first[dim], const long count[dim], F &&f) const;
-    // Whether `cell` covers a lattice cell of a block flagged in blocks.
-    bool meets_blocks(const typename dealii::Triangulation<dim>::cell_iterator &cell,
-                      const std::vector<unsigned char> &blocks) const;
+    // The box of blocks (along each axis, inclusive) around the fine region: a coarse cell far
+    // from the material is not searched block by block.
+    long fine_region_lower[dim] = {}, fine_region_upper[dim] = {};
+    // Whether `cell` covers a lattice cell of a block of the fine region.
+    bool meets_fine_region(const typename dealii::Triangulation<dim>::cell_iterator &cell) const;
 
     // The exchanges over the node and the cell partitioner (all arrays of a call in one
     // round of messages), and the scratch of sum_cells.
