@@ -403,9 +403,10 @@ namespace mpm
               ++twos;
             levels = std::min(levels, twos);
           }
-        const double coarse_cells = e.n_cells / std::pow(double(p.cells_per_grid_cell << levels), dim);
-        e.grid_bytes              = b.cell * std::min(e.n_cells, 4 * material_cells);
-        per_rank_grid_bytes       = 6 * n_blocks + b.cell * coarse_cells;
+        e.coarse_cell_edge = double(p.cells_per_grid_cell << levels);
+        e.n_coarse_cells   = e.n_cells / std::pow(e.coarse_cell_edge, dim);
+        e.grid_bytes       = b.cell * std::min(e.n_cells, 4 * material_cells);
+        per_rank_grid_bytes = 6 * n_blocks + b.cell * e.n_coarse_cells;
       }
     e.point_bytes    = b.point * e.n_points;
     e.per_rank_bytes = b.program + b.generated_point * e.n_points + field_bytes + per_rank_grid_bytes;
@@ -614,7 +615,12 @@ namespace mpm
                           e.per_rank_grid_bytes;
     const double grid   = e.grid_bytes + n_ranks * e.per_rank_grid_bytes;
     std::string  entry  = "Grid/Cell size";
-    if (e.point_bytes > grid && e.point_bytes > fields && !p.bodies.empty())
+    // Near the material on several ranks: deal.II's coarse grid, on every rank, can be the most.
+    const bool coarse_grid = n_ranks * e.per_rank_grid_bytes > std::max(e.grid_bytes, e.point_bytes) &&
+                             e.per_rank_grid_bytes > fields;
+    if (coarse_grid)
+      entry = "Grid/Cells per deal.II cell";
+    else if (e.point_bytes > grid && e.point_bytes > fields && !p.bodies.empty())
       {
         unsigned int largest = 0;
         for (unsigned int b = 1; b < p.bodies.size(); ++b)
@@ -633,11 +639,20 @@ namespace mpm
                         " GB)";
     if (e.n_field_nodes > 0)
       parts += ", random fields of " + number(e.n_field_nodes) + " nodes (" + number(fields / GB) + " GB on each rank)";
+    if (coarse_grid)
+      parts += "; of the grid, deal.II's coarse grid on each rank: " + number(e.n_coarse_cells) + " cells of " +
+               number(e.coarse_cell_edge) + " lattice cells along each axis (Cells per deal.II cell = " +
+               std::to_string(p.cells_per_grid_cell) + " times the largest power of two, at most 1024, that "
+               "divides every count of deal.II cells), " + number(e.per_rank_grid_bytes / GB) + " GB";
+    const std::string advice =
+      coarse_grid ? "Raise Grid/Cells per deal.II cell (it must divide the cells along every direction), or choose "
+                    "the extent and Grid/Cell size so that the cell counts hold powers of two; more ranks do not "
+                    "help, every rank holds the coarse grid." :
+                    "Check Grid/Cell size (a mistyped exponent?) and Points per cell direction, or run on more nodes.";
     refuse(entry, "the run would need about " + number(need / GB) + " GB" +
                     (n_ranks > 1 && !(p.memory_limit > 0) ? " per rank" : "") + ", more than the " +
                     number(available / GB) + " GB of " + against + ". Estimated from the prm (doc/guards.md): " +
-                    parts + ", on " + std::to_string(n_ranks) + " rank(s). Check Grid/Cell size (a mistyped "
-                    "exponent?) and Points per cell direction, or run on more nodes; Resources/Memory limit (GB, "
-                    "> 0) replaces the machine's available memory as the limit.");
+                    parts + ", on " + std::to_string(n_ranks) + " rank(s). " + advice + " Resources/Memory limit "
+                    "(GB, > 0) replaces the machine's available memory as the limit.");
   }
 } // namespace mpm

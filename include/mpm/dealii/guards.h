@@ -81,6 +81,7 @@ namespace mpm
     double point_bytes = 0; // the handler's and the engine's points, output copies: shared by the ranks
     double per_rank_bytes = 0; // on every rank: the generated bodies, the random fields, per_rank_grid_bytes
     double per_rank_grid_bytes = 0; // on every rank: the coarse grid and block tables (near the material, CPU ranks)
+    double n_coarse_cells = 0, coarse_cell_edge = 0; // that coarse grid: its cells, their edge in lattice cells
     // The whole run on n ranks, and what one rank needs.
     double total(const unsigned int n_ranks) const { return grid_bytes + point_bytes + n_ranks * per_rank_bytes; }
     double of_one_rank(const unsigned int n_ranks) const
