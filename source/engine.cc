@@ -188,7 +188,7 @@ namespace mpm
       }
 
       // Several ranks: every rank keeps the node blocks around the cell blocks that hold a
-      // point on any rank (a byte per block, the maximum over the ranks), so that the owner of
+      // point on any rank (each rank's list, gathered and merged: blocks_of_every_rank), so that the owner of
       // a node zeroes and updates it wherever another rank's points add into it. The arrays
       // are those of the rank's fine cells of deal.II's grid (fine within two blocks of the
       // points, BackgroundGrid::coarse_away_from_material); the node loops visit the kept
