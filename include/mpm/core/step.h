@@ -146,6 +146,24 @@ namespace mpm
                             // a blow-up that throws points out must not pass unnoticed
   };
 
+  // The fused step (explicit_step's last argument; MUSL and USL on backends whose scatter is
+  // atomic, the device's). The kinematics pass of one step reads only the nodal velocities,
+  // and P2G writes only the nodal mass, momentum and force, so the step can zero those once
+  // the velocities are formed and let each point, right after its own kinematics, add its
+  // P2G of the next step: the same values into the same sums as the next step's P2G pass
+  // would add (the next P2G reads no time step, and of the settings only the gravity may
+  // change), without that pass reading the points again. The caller asks for it only where
+  // nothing reads or changes the grid or the points between the two steps other than a
+  // re-sort (a permutation of the points leaves the sums as they are): not before an output
+  // of the grid, a change of the grid's nodes, points added or removed by the host.
+  template <int dim, typename Real>
+  struct FusedTransfer
+  {
+    bool carry_next        = false; // in: this step's kinematics also runs the next step's P2G
+    Real next_gravity[dim] = {};    // in: the next step's gravity (with its ramp)
+    bool p2g_carried       = false; // in/out: this step's P2G ran in the last step; set by the step
+  };
+
   // Hooks between a P2G pass and the nodal update, where ranks sum their ghost
   // contributions (deal.II's Partitioner import/export in the deal.II layer). The core needs none.
   // sum_cells: the same for the per-cell sums of the pressure averaging (arrays over
@@ -513,7 +531,109 @@ namespace mpm
         p.state_variables[s.affine_state_variable + k][i] = C[k];
     }
 
-    // P2G: nodal mass and momentum, and/or internal (-V sigma . grad N) and gravity forces.
+    // P2G of point i (not removed): nodal mass and momentum, and/or internal
+    // (-V sigma . grad N) and gravity forces. particles_to_grid runs it for every point; the
+    // fused step (explicit_step, FusedTransfer) at the end of each point's kinematics.
+    template <typename Backend, int dim, typename Shape, typename Real>
+    MPM_HOST_DEVICE inline void point_to_grid(const GridView<dim, Real> &g, const PointsView<dim, Real> &p,
+                                              const StepSettings<dim, Real> &s, const int i,
+                                              const bool mass_and_momentum, const bool forces, void *stencils,
+                                              const bool apply_averaging, const MaterialParameters<Real> *disconnecting)
+    {
+      Real x[dim], lp[domain_values<dim, Shape>()], v[dim];
+      for (int d = 0; d < dim; ++d)
+        {
+          x[d]  = p.position[d][i];
+          v[d]  = p.velocity[d][i];
+        }
+      load_domain<dim, Shape>(p, s, i, lp);
+      const Real m = p.mass[i], V = p.volume[i];
+      SymTensor<Real> sigma;
+      for (int c = 0; c < n_voigt; ++c)
+        sigma[c] = p.stress[c][i];
+      if (apply_averaging && averages_pressure(disconnecting, p, i)) // the last step's, left pending (explicit_step)
+        {
+          const Real shift = cell_pressure_shift(g, x, sigma[0], sigma[1], sigma[2]);
+          for (int k = 0; k < 3; ++k)
+            {
+              sigma[k] += shift;
+              p.stress[k][i] = sigma[k];
+            }
+        }
+
+      // Nodal arrays in the order of the values: mass, momentum, force. Each value is
+      // linear in N and grad N (stencil_contribution.h): mass m N, momentum m v N, force
+      // m g N - V sigma . grad N.
+      constexpr int K = 2 * dim + 1;
+      Real         *targets[K];
+      targets[0] = g.mass;
+      for (int d = 0; d < dim; ++d)
+        {
+          targets[1 + d]       = g.momentum[d];
+          targets[1 + dim + d] = g.force[d];
+        }
+      StencilContribution<dim, K, dim, Real> all;
+      all.c_N[0] = m;
+      for (int d = 0; d < dim; ++d)
+        {
+          all.c_N[1 + d]       = m * v[d];
+          all.c_N[1 + dim + d] = m * s.gravity[d];
+#ifndef __CUDA_ARCH__
+          if (s.body_force_state_variable >= 0)
+            all.c_N[1 + dim + d] += m * p.state_variables[s.body_force_state_variable + d][i];
+#endif
+          for (int e = 0; e < dim; ++e)
+            all.c_grad[d][e] = -V * sigma(d, e);
+        }
+      (void)stencils; // the host keeps them; the device computes each stencil again
+#if defined(__CUDA_ARCH__) || defined(MPM_UNROLL_STENCIL)
+      auto scatter = [&](const auto &contribution, Real *const *into) {
+        Backend::template scatter_stencil<dim, Shape>(g, x, lp, into, contribution);
+      };
+#else
+      // Host: the stencil, kept for the later stages of the step where they asked for it.
+      const HostStencil<dim, Shape, Real> stencil(g, x, lp);
+      if (stencils != nullptr)
+        static_cast<HostStencil<dim, Shape, Real> *>(stencils)[i] = stencil;
+      auto scatter = [&](const auto &contribution, Real *const *into) {
+        add_contribution<Backend>([&](auto &&visit) { stencil.for_each(g, visit); }, into, contribution);
+      };
+#endif
+      if (mass_and_momentum && forces)
+        scatter(all, targets);
+      else if (mass_and_momentum)
+        {
+          StencilContribution<dim, dim + 1, 0, Real> mass_momentum;
+          for (int k = 0; k <= dim; ++k)
+            mass_momentum.c_N[k] = all.c_N[k];
+          scatter(mass_momentum, targets);
+        }
+      else if (forces)
+        {
+          StencilContribution<dim, dim, dim, Real> force;
+          for (int d = 0; d < dim; ++d)
+            {
+              force.c_N[d] = all.c_N[1 + dim + d];
+              for (int e = 0; e < dim; ++e)
+                force.c_grad[d][e] = all.c_grad[d][e];
+            }
+          scatter(force, targets + dim + 1);
+        }
+      // Atomic backends: add_affine_momentum, after this pass.
+      if constexpr (!atomic_scatter<Backend>::value)
+        if (mass_and_momentum && s.affine_state_variable >= 0)
+          {
+            Real C[dim * dim];
+            load_affine(p, s, i, C);
+#if defined(__CUDA_ARCH__) || defined(MPM_UNROLL_STENCIL)
+            add_apic_momentum<Backend, dim>(g, PointStencil<dim, Shape, Real>{x, lp}, x, m, C);
+#else
+            add_apic_momentum<Backend, dim>(g, stencil, x, m, C);
+#endif
+          }
+    }
+
+    // P2G of every point.
     template <int dim, typename Shape, DevicePhysics physics = DevicePhysics::standard, typename Real,
               typename Backend>
     void particles_to_grid(Backend                          &backend,
@@ -527,99 +647,9 @@ namespace mpm
                            const MaterialParameters<Real>   *disconnecting = nullptr)
     {
       backend.scatter_points(p.n_points, [=] MPM_HOST_DEVICE(const int i) {
-        if (p.material[i] < 0)
-          return;
-        Real x[dim], lp[domain_values<dim, Shape>()], v[dim];
-        for (int d = 0; d < dim; ++d)
-          {
-            x[d]  = p.position[d][i];
-            v[d]  = p.velocity[d][i];
-          }
-        load_domain<dim, Shape>(p, s, i, lp);
-        const Real m = p.mass[i], V = p.volume[i];
-        SymTensor<Real> sigma;
-        for (int c = 0; c < n_voigt; ++c)
-          sigma[c] = p.stress[c][i];
-        if (apply_averaging && averages_pressure(disconnecting, p, i)) // the last step's, left pending (explicit_step)
-          {
-            const Real shift = cell_pressure_shift(g, x, sigma[0], sigma[1], sigma[2]);
-            for (int k = 0; k < 3; ++k)
-              {
-                sigma[k] += shift;
-                p.stress[k][i] = sigma[k];
-              }
-          }
-
-        // Nodal arrays in the order of the values: mass, momentum, force. Each value is
-        // linear in N and grad N (stencil_contribution.h): mass m N, momentum m v N, force
-        // m g N - V sigma . grad N.
-        constexpr int K = 2 * dim + 1;
-        Real         *targets[K];
-        targets[0] = g.mass;
-        for (int d = 0; d < dim; ++d)
-          {
-            targets[1 + d]       = g.momentum[d];
-            targets[1 + dim + d] = g.force[d];
-          }
-        StencilContribution<dim, K, dim, Real> all;
-        all.c_N[0] = m;
-        for (int d = 0; d < dim; ++d)
-          {
-            all.c_N[1 + d]       = m * v[d];
-            all.c_N[1 + dim + d] = m * s.gravity[d];
-#ifndef __CUDA_ARCH__
-            if (s.body_force_state_variable >= 0)
-              all.c_N[1 + dim + d] += m * p.state_variables[s.body_force_state_variable + d][i];
-#endif
-            for (int e = 0; e < dim; ++e)
-              all.c_grad[d][e] = -V * sigma(d, e);
-          }
-        (void)stencils; // captured in both compilation passes (nvcc's extended lambdas need the same captures)
-#if defined(__CUDA_ARCH__) || defined(MPM_UNROLL_STENCIL)
-        auto scatter = [&](const auto &contribution, Real *const *into) {
-          Backend::template scatter_stencil<dim, Shape>(g, x, lp, into, contribution);
-        };
-#else
-        // Host: the stencil, kept for the later stages of the step where they asked for it.
-        const HostStencil<dim, Shape, Real> stencil(g, x, lp);
-        if (stencils != nullptr)
-          static_cast<HostStencil<dim, Shape, Real> *>(stencils)[i] = stencil;
-        auto scatter = [&](const auto &contribution, Real *const *into) {
-          add_contribution<Backend>([&](auto &&visit) { stencil.for_each(g, visit); }, into, contribution);
-        };
-#endif
-        if (mass_and_momentum && forces)
-          scatter(all, targets);
-        else if (mass_and_momentum)
-          {
-            StencilContribution<dim, dim + 1, 0, Real> mass_momentum;
-            for (int k = 0; k <= dim; ++k)
-              mass_momentum.c_N[k] = all.c_N[k];
-            scatter(mass_momentum, targets);
-          }
-        else if (forces)
-          {
-            StencilContribution<dim, dim, dim, Real> force;
-            for (int d = 0; d < dim; ++d)
-              {
-                force.c_N[d] = all.c_N[1 + dim + d];
-                for (int e = 0; e < dim; ++e)
-                  force.c_grad[d][e] = all.c_grad[d][e];
-              }
-            scatter(force, targets + dim + 1);
-          }
-        // Atomic backends: add_affine_momentum, after this pass.
-        if constexpr (!atomic_scatter<Backend>::value)
-          if (mass_and_momentum && s.affine_state_variable >= 0)
-            {
-              Real C[dim * dim];
-              load_affine(p, s, i, C);
-#if defined(__CUDA_ARCH__) || defined(MPM_UNROLL_STENCIL)
-              add_apic_momentum<Backend, dim>(g, PointStencil<dim, Shape, Real>{x, lp}, x, m, C);
-#else
-              add_apic_momentum<Backend, dim>(g, stencil, x, m, C);
-#endif
-            }
+        if (p.material[i] >= 0)
+          point_to_grid<Backend, dim, Shape>(g, p, s, i, mass_and_momentum, forces, stencils, apply_averaging,
+                                             disconnecting);
       });
     }
 
@@ -902,20 +932,34 @@ namespace mpm
     // A point whose centre leaves the grid is marked removed (material = -1).
     // The particle domain is rescaled only in the pass that moves the points, so that
     // every transfer of one step uses the same stencil (USF deforms before it moves).
-    template <int dim, typename Shape, DevicePhysics physics = DevicePhysics::standard, typename Real,
-              typename Backend>
+    // carry_p2g (atomic backends only, explicit_step's FusedTransfer): each point's P2G of
+    // the next step too, with next_gravity, after its own update (the grid's mass, momentum
+    // and force zeroed before). A template argument, so that the unfused pass compiles as
+    // before (the fused one holds the stencil scatter's shared records instead of
+    // add_to_node's staging area).
+    template <int dim, typename Shape, DevicePhysics physics = DevicePhysics::standard, bool carry_p2g = false,
+              typename Real, typename Backend>
     void grid_to_particle_kinematics(Backend &backend, const GridView<dim, Real> &g,
                                      const PointsView<dim, Real> &p,
                                      const MaterialParameters<Real> *materials,
                                      const StepSettings<dim, Real> &s, const Real dt_given,
                                      const bool move_points, const bool deform_points,
-                                     const void *stencils = nullptr, const bool scatter_pressure = false)
+                                     const void *stencils = nullptr, const bool scatter_pressure = false,
+                                     const Real *next_gravity = nullptr)
     {
       // scatter_pressure (atomic backends only): the first pass of the pressure averaging
       // too, at the end of each point's update (one pass over the points less).
       if constexpr (!atomic_scatter<Backend>::value)
-        if (scatter_pressure)
+        if (scatter_pressure || carry_p2g)
           throw std::invalid_argument("grid_to_particle_kinematics: this backend scatters only in scatter_points");
+      if (carry_p2g && (scatter_pressure || next_gravity == nullptr))
+        throw std::invalid_argument("grid_to_particle_kinematics: the next step's P2G needs its gravity and no "
+                                    "pressure averaging");
+      StepSettings<dim, Real> next = s; // the next P2G's settings (captured only where it runs)
+      if (next_gravity != nullptr)
+        for (int d = 0; d < dim; ++d)
+          next.gravity[d] = next_gravity[d];
+      (void)next;
       const MaterialParameters<Real> *disconnecting = disconnecting_materials(s, materials);
       backend.gather_points(p.n_points, [=] MPM_HOST_DEVICE(const int i) {
         if (p.material[i] < 0)
@@ -1071,6 +1115,8 @@ namespace mpm
 
         if (leaves_grid)
           p.material[i] = -1;
+        else if constexpr (carry_p2g)
+          point_to_grid<Backend, dim, Shape, Real>(g, p, next, i, true, true, nullptr, false, nullptr);
         else if (scatter_pressure)
           add_cell_pressure_atomically<Backend>(g, p, i, disconnecting);
       });
@@ -1230,9 +1276,25 @@ namespace mpm
                                     const PointsView<dim, Real> &p,
                                     const MaterialParameters<Real> *materials,
                                     const StepSettings<dim, Real> &s, const Real dt,
-                                    const Exchange &exchange = Exchange(), bool *averaging_pending = nullptr)
+                                    const Exchange &exchange = Exchange(), bool *averaging_pending = nullptr,
+                                    FusedTransfer<dim, Real> *fused = nullptr)
   {
     using namespace stages;
+    // The fused step (FusedTransfer): this step's P2G ran in the last one (carried), and/or
+    // this one runs the next one's (carry).
+    const bool carried = fused != nullptr && fused->p2g_carried;
+    const bool carry   = fused != nullptr && fused->carry_next;
+    if (carried || carry)
+      {
+        if (!atomic_scatter<Backend>::value)
+          throw std::invalid_argument("explicit_step: the fused step needs a backend whose scatter is atomic");
+        if (s.scheme == UpdateScheme::usf)
+          throw std::invalid_argument("explicit_step: the fused step runs MUSL and USL (USF's last pass does not "
+                                      "deform the points)");
+        if (s.pressure_averaging || s.hold_points || s.affine_state_variable >= 0)
+          throw std::invalid_argument("explicit_step: the fused step runs without pressure averaging (the next "
+                                      "P2G reads the averaged stresses), held points and affine transfers");
+      }
     if (s.affine_state_variable >= 0)
       {
         if (atomic_scatter<Backend>::value && physics != DevicePhysics::all)
@@ -1331,6 +1393,26 @@ namespace mpm
           scatter_averaged_pressure();
         }
     };
+    // MUSL and USL: the grid zeroed and P2G, or only the sums where the last step ran this P2G.
+    auto p2g_unless_carried = [&](void *stencils) {
+      if (carried)
+        {
+          exchange.sum_nodal(p2g_sums, 2 * dim + 1);
+          return;
+        }
+      reset_grid(backend, g, true, s.pressure_averaging && !apply_pending);
+      particles_to_grid_then_sum(stencils);
+    };
+    // The kinematics carrying the next step's P2G into a grid zeroed after the nodal
+    // velocities, the only nodal values the kinematics reads, are formed.
+    auto carry_next_p2g = [&]() {
+      if constexpr (atomic_scatter<Backend>::value) // the others are refused above
+        {
+          reset_grid(backend, g, true);
+          grid_to_particle_kinematics<dim, Shape, physics, true>(backend, g, p, materials, s, dt, true, true,
+                                                                 nullptr, false, fused->next_gravity);
+        }
+    };
     switch (s.scheme)
       {
         case UpdateScheme::musl:
@@ -1342,8 +1424,7 @@ namespace mpm
             if constexpr (has_point_scratch<Backend>::value)
               stencils = backend.point_scratch(p.n_points, sizeof(HostStencil<dim, Shape, Real>));
 #endif
-            reset_grid(backend, g, true, s.pressure_averaging && !apply_pending);
-            particles_to_grid_then_sum(stencils);
+            p2g_unless_carried(stencils);
             update_grid(backend, g, s, dt, true, apply_pending);
             pass_then_sum(
               exchange, n_first, p,
@@ -1354,22 +1435,27 @@ namespace mpm
               ExchangedEntries::nodes, momentum, dim, sum_nodal(momentum, dim));
             if (!s.hold_points || s.hold_from_point_momentum) // held, the grid keeps its updated ones
               velocity_from_momentum(backend, g, s.mass_tolerance);
-            kinematics_then_cell_sums([&](const PointsView<dim, Real> &q) {
-              grid_to_particle_kinematics<dim, Shape, physics>(backend, g, q, materials, s, dt, true, true, stencils,
-                                                               scatter_in_kinematics);
-            });
+            if (carry)
+              carry_next_p2g();
+            else
+              kinematics_then_cell_sums([&](const PointsView<dim, Real> &q) {
+                grid_to_particle_kinematics<dim, Shape, physics>(backend, g, q, materials, s, dt, true, true,
+                                                                 stencils, scatter_in_kinematics);
+              });
           }
           break;
 
         case UpdateScheme::usl:
-          reset_grid(backend, g, true, s.pressure_averaging && !apply_pending);
-          particles_to_grid_then_sum(nullptr);
+          p2g_unless_carried(nullptr);
           update_grid(backend, g, s, dt, false, apply_pending);
           grid_to_particle_velocity<dim, Shape, physics>(backend, g, p, s);
-          kinematics_then_cell_sums([&](const PointsView<dim, Real> &q) {
-            grid_to_particle_kinematics<dim, Shape, physics>(backend, g, q, materials, s, dt, true, true, nullptr,
-                                                             scatter_in_kinematics);
-          });
+          if (carry)
+            carry_next_p2g();
+          else
+            kinematics_then_cell_sums([&](const PointsView<dim, Real> &q) {
+              grid_to_particle_kinematics<dim, Shape, physics>(backend, g, q, materials, s, dt, true, true, nullptr,
+                                                               scatter_in_kinematics);
+            });
           break;
 
         case UpdateScheme::usf:
@@ -1391,6 +1477,8 @@ namespace mpm
       }
     if constexpr (colours_scatter<Backend>::value)
       backend.ungroup(); // the points have moved: the next group_for_scatter checks the grouping again
+    if (fused != nullptr)
+      fused->p2g_carried = carry;
     // MUSL and USL average at the end of the step. Deferred (averaging_pending given), the
     // points keep their stresses before the averaging and the grid its cell sums: the next
     // step's P2G applies it as it reads the stresses (one pass over the points less), and
@@ -1411,27 +1499,26 @@ namespace mpm
                                     const GridView<dim, Real> &g, const PointsView<dim, Real> &p,
                                     const MaterialParameters<Real> *materials,
                                     const StepSettings<dim, Real> &s, const Real dt,
-                                    const Exchange &exchange = Exchange(), bool *averaging_pending = nullptr)
+                                    const Exchange &exchange = Exchange(), bool *averaging_pending = nullptr,
+                                    FusedTransfer<dim, Real> *fused = nullptr)
   {
     if (shape == ShapeFunction::gimp)
-      return explicit_step<dim, GimpShape, physics>(backend, g, p, materials, s, dt, exchange, averaging_pending);
+      return explicit_step<dim, GimpShape, physics>(backend, g, p, materials, s, dt, exchange, averaging_pending, fused);
     if (shape == ShapeFunction::bspline2)
-      return explicit_step<dim, QuadraticBSplineShape, physics>(backend, g, p, materials, s, dt, exchange, averaging_pending);
+      return explicit_step<dim, QuadraticBSplineShape, physics>(backend, g, p, materials, s, dt, exchange, averaging_pending, fused);
     if (shape == ShapeFunction::bspline3)
-      return explicit_step<dim, CubicBSplineShape, physics>(backend, g, p, materials, s, dt, exchange, averaging_pending);
+      return explicit_step<dim, CubicBSplineShape, physics>(backend, g, p, materials, s, dt, exchange, averaging_pending, fused);
     if (shape == ShapeFunction::bspline3_gimp)
-      return explicit_step<dim, CubicBSplineGimpShape, physics>(backend, g, p, materials, s, dt, exchange,
-                                                                averaging_pending);
+      return explicit_step<dim, CubicBSplineGimpShape, physics>(backend, g, p, materials, s, dt, exchange, averaging_pending, fused);
     if (shape == ShapeFunction::cpdi)
-      return explicit_step<dim, CpdiShape, physics>(backend, g, p, materials, s, dt, exchange, averaging_pending);
+      return explicit_step<dim, CpdiShape, physics>(backend, g, p, materials, s, dt, exchange, averaging_pending, fused);
     if (shape == ShapeFunction::cpdi2q)
       {
         if constexpr (dim == 2)
-          return explicit_step<dim, Cpdi2qShape, physics>(backend, g, p, materials, s, dt, exchange,
-                                                          averaging_pending);
+          return explicit_step<dim, Cpdi2qShape, physics>(backend, g, p, materials, s, dt, exchange, averaging_pending, fused);
         else
           throw std::invalid_argument("explicit_step: CPDI2q is two-dimensional");
       }
-    return explicit_step<dim, LinearShape, physics>(backend, g, p, materials, s, dt, exchange, averaging_pending);
+    return explicit_step<dim, LinearShape, physics>(backend, g, p, materials, s, dt, exchange, averaging_pending, fused);
   }
 } // namespace mpm

@@ -1,0 +1,67 @@
+// P1 (benchmarks/p1_scene.h, Drucker-Prager) stepped with or without the fused step
+// (FusedTransfer, step.h), on any Target (targets.h), so that the CPU test and its GPU twin
+// compare the same runs.
+#pragma once
+
+#include "../../benchmarks/p1_scene.h"
+
+#include <mpm/core/host_storage.h>
+#include <mpm/core/step.h>
+
+#include <type_traits>
+#include <vector>
+
+namespace mpm_test
+{
+  struct FusedRun
+  {
+    int                 n_cells_y = 2; // 10,024 points
+    long                n_steps   = 150;
+    bool                fused     = false;
+    mpm::UpdateScheme   scheme    = mpm::UpdateScheme::musl;
+    bool                drucker_prager = true;
+    double              damping        = mpm_bench::P1::damping;
+  };
+
+  // The steps at P1's adaptive time step and ramped gravity; a fused step carries the next
+  // step's P2G with the gravity of the next step's time. Returns the time reached.
+  template <template <int, typename> class Target, typename Shape = mpm::GimpShape>
+  double p1_fused_or_not(const FusedRun &run, mpm::HostPoints<3, double> &points)
+  {
+    using namespace mpm;
+    using mpm_bench::P1;
+    HostGrid<3, double>                     grid;
+    std::vector<MaterialParameters<double>> materials;
+    mpm_bench::make_p1(run.n_cells_y, grid, points, materials, run.drucker_prager);
+    StepSettings<3, double> s = mpm_bench::p1_settings<double>();
+    s.scheme                  = run.scheme;
+    s.damping                 = run.damping;
+    if constexpr (!std::is_same_v<Shape, GimpShape> && !std::is_same_v<Shape, CubicBSplineGimpShape>)
+      s.domain_update = DomainUpdate::none; // as p1_benchmark: only the GIMP shapes have domains to update
+    const double            c = mpm_bench::p1_wave_speed();
+    Target<3, double>       target(grid, points, materials);
+    const auto              gv = target.grid();
+    FusedTransfer<3, double> fused;
+    double                  t = 0, max_speed = 0;
+    for (long step = 0; step < run.n_steps; ++step)
+      {
+        const double dt = P1::cfl * P1::h / (c + max_speed);
+        mpm_bench::p1_gravity(s, t);
+        if (run.fused)
+          {
+            StepSettings<3, double> next = s;
+            mpm_bench::p1_gravity(next, t + dt);
+            fused.carry_next = step + 1 < run.n_steps;
+            for (int d = 0; d < 3; ++d)
+              fused.next_gravity[d] = next.gravity[d];
+          }
+        const auto pv = target.template points_at_step<Shape>(step);
+        max_speed     = explicit_step<3, Shape>(target.backend, gv, pv, target.material_table(), s, dt,
+                                            NoGridExchange(), nullptr, run.fused ? &fused : nullptr)
+                      .max_speed;
+        t += dt;
+      }
+    target.finish();
+    return t;
+  }
+} // namespace mpm_test
