@@ -22,6 +22,9 @@
 //   --shape gimp|linear|bspline2|bspline3|bspline3gimp|cpdi   the shape function (default gimp;
 //                                                bspline3gimp: the cubic B-spline GIMP, --domain as for GIMP)
 //   --domain detF|Fii|U|none                GIMP's domain update (default detF, P1's own)
+//   --fused                 the fused step (step.h, FusedTransfer): each step's kinematics carries
+//                           the next step's P2G (the last timed step and the later sections run
+//                           unfused); the sanity columns show whether the physics stayed the same
 //   --launch-modes N        after the timed run, N steps at a fixed time step three ways: the
 //                           reduction read back after every step (as the programs run), never
 //                           read back (the host runs ahead), and each step one CUDA graph
@@ -66,6 +69,7 @@ namespace
     bool             hencky   = false;
     bool             all_physics() const { return affine || hencky; }
     long             launch_mode_steps = 0;
+    bool             fused             = false;
   };
 
   // What the host's round trip per step and the launches themselves cost: N steps at a fixed
@@ -242,6 +246,10 @@ namespace
                                      "G2P velocity + remap P2G", "nodal velocity",
                                      "G2P kinematics+stress", "reduction (dt)"};
   constexpr int n_musl_launches = 7;
+  // A fused step's launches: the P2G runs inside the last step's kinematics.
+  const char *fused_launch_names[] = {"grid update", "G2P velocity + remap P2G", "nodal velocity",
+                                      "reset grid", "G2P kinematics+stress+next P2G", "reduction (dt)"};
+  constexpr int n_fused_launches = 6;
 
   template <typename Real>
   bool run_size(const int n_cells_y, const Options &opt, const double bandwidth, FILE *table)
@@ -321,10 +329,24 @@ namespace
         s.flip_fraction         = 0;
       }
     const double          c = mpm_bench::p1_wave_speed();
+    // fused (--fused): the step's P2G ran in the last step where that one carried it, and this
+    // one carries the next one's where fused.carry_next is set.
+    FusedTransfer<3, Real> fused;
     auto step = [&](const double dt) {
+      FusedTransfer<3, Real> *f = opt.fused ? &fused : nullptr;
       return opt.all_physics() ?
-               explicit_step<3, DevicePhysics::all>(backend, opt.shape, gv, pv, dmaterials.data(), s, Real(dt)) :
-               explicit_step<3>(backend, opt.shape, gv, pv, dmaterials.data(), s, Real(dt));
+               explicit_step<3, DevicePhysics::all>(backend, opt.shape, gv, pv, dmaterials.data(), s, Real(dt),
+                                                    NoGridExchange(), nullptr, f) :
+               explicit_step<3>(backend, opt.shape, gv, pv, dmaterials.data(), s, Real(dt), NoGridExchange(),
+                                nullptr, f);
+    };
+    // Whether the step at time t with time step dt carries the next one's P2G, and with which gravity.
+    auto plan_fusion = [&](const double t, const double dt, const bool next_runs) {
+      fused.carry_next = opt.fused && next_runs;
+      StepSettings<3, Real> next = s;
+      mpm_bench::p1_gravity(next, t + dt);
+      for (int d = 0; d < 3; ++d)
+        fused.next_gravity[d] = next.gravity[d];
     };
 
     // Warm-up (module load, first launches), then back to the initial state.
@@ -335,6 +357,7 @@ namespace
           sort_if_due(i);
           const double dt = P1::cfl * P1::h / (c + max_speed);
           mpm_bench::p1_gravity(s, t);
+          plan_fusion(t, dt, i < 2);
           max_speed = step(dt).max_speed;
           t += dt;
         }
@@ -357,10 +380,12 @@ namespace
         sort_if_due(steps);
         const double dt = P1::cfl * P1::h / (c + max_speed);
         mpm_bench::p1_gravity(s, t);
+        plan_fusion(t, dt, t + dt < P1::t_end - 1e-9 && (opt.steps < 0 || steps + 1 < opt.steps));
         max_speed = step(dt).max_speed;
         t += dt;
         ++steps;
       }
+    fused.carry_next = false; // the sections below run unfused
     MPM_CUDA_CHECK(cudaEventRecord(stop, backend.get_stream()));
     MPM_CUDA_CHECK(cudaEventSynchronize(stop));
     const double host_wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
@@ -407,6 +432,8 @@ namespace
       label += opt.affine_matrix == AffineMatrix::b_d_inverse ? ", APIC" : ", TPIC";
     if (opt.hencky)
       label += ", Hencky";
+    if (opt.fused)
+      label += ", fused";
     label += opt.sort_every > 0 ? ", sorted every " + std::to_string(opt.sort_every) : ", unsorted";
     const double updates  = double(n_points) * steps / wall;
     const double bytes    = minimal_bytes_per_step<Real>(n_points, n_nodes);
@@ -430,9 +457,19 @@ namespace
 
     if (opt.profile)
       {
+        // Fused: one step untimed that carries the next one's P2G, then every timed step carries
+        // one too (the gravity as it is: the profile measures, it does not run on).
+        const char *const *names = opt.fused ? fused_launch_names : musl_launch_names;
+        if (opt.fused)
+          {
+            fused.carry_next = true;
+            for (int d = 0; d < 3; ++d)
+              fused.next_gravity[d] = s.gravity[d];
+            max_speed = step(P1::cfl * P1::h / (c + max_speed)).max_speed;
+          }
         backend.enable_kernel_timing(true);
         const int          n_prof = 5;
-        std::vector<double> sum(n_musl_launches, 0.0);
+        std::vector<double> sum(opt.fused ? n_fused_launches : n_musl_launches, 0.0);
         for (int i = 0; i < n_prof; ++i)
           {
             const double dt = P1::cfl * P1::h / (c + max_speed);
@@ -448,17 +485,18 @@ namespace
         std::printf("  per-launch times, %s, %d points (mean of %d steps; sum %.3f ms/step vs %.3f ms/step timed):\n",
                     sizeof(Real) == 8 ? "FP64" : "FP32", n_points, n_prof, total / n_prof, wall / steps * 1e3);
         for (size_t k = 0; k < sum.size(); ++k)
-          std::printf("    %-26s %8.3f ms  %5.1f%%\n", musl_launch_names[k], sum[k] / n_prof, 100 * sum[k] / total);
+          std::printf("    %-30s %8.3f ms  %5.1f%%\n", names[k], sum[k] / n_prof, 100 * sum[k] / total);
         if (table != nullptr)
           {
             std::fprintf(table, "\nPer-launch times, %s, %d points, ms per step (mean of %d steps):\n\n",
                          sizeof(Real) == 8 ? "FP64" : "FP32", n_points, n_prof);
             std::fprintf(table, "| launch | ms | share |\n|---|---|---|\n");
             for (size_t k = 0; k < sum.size(); ++k)
-              std::fprintf(table, "| %s | %.3f | %.1f%% |\n", musl_launch_names[k], sum[k] / n_prof,
+              std::fprintf(table, "| %s | %.3f | %.1f%% |\n", names[k], sum[k] / n_prof,
                            100 * sum[k] / total);
             std::fprintf(table, "\n");
           }
+        fused.carry_next = false; // the last profiled step carried one: the next step adds no P2G of its own
       }
     if (opt.launch_mode_steps > 0)
       {
@@ -544,6 +582,8 @@ int main(int argc, char **argv)
             }
           opt.hencky = m == "hencky";
         }
+      else if (a == "--fused")
+        opt.fused = true;
       else if (a == "--launch-modes" && i + 1 < argc)
         opt.launch_mode_steps = std::atol(argv[++i]);
       else if (a == "--block" && i + 1 < argc)
@@ -567,7 +607,7 @@ int main(int argc, char **argv)
           std::printf("usage: %s [--fp32] [--sizes 20,160,640,2560] [--steps N] [--profile] [--table FILE]\n"
                       "          [--order generated|cell|random] [--block N] [--material dp|elastic] [--sort-every N]\n"
                       "          [--shape gimp|linear|bspline2|bspline3|bspline3gimp|cpdi] [--domain detF|Fii|U|none]\n"
-                      "          [--transfer tpic|apic] [--law jaumann|hencky] [--launch-modes N]\n",
+                      "          [--transfer tpic|apic] [--law jaumann|hencky] [--fused] [--launch-modes N]\n",
                       argv[0]);
           return 2;
         }

@@ -8,6 +8,8 @@
 #include <mpm/core/host_storage.h>
 #include <mpm/core/step.h>
 
+#include <algorithm>
+#include <cmath>
 #include <type_traits>
 #include <vector>
 
@@ -63,5 +65,34 @@ namespace mpm_test
       }
     target.finish();
     return t;
+  }
+
+  // Largest difference over the points: positions in cells, velocities and stresses
+  // relative to their largest magnitude; removed points must match.
+  inline double largest_difference(const mpm::HostPoints<3, double> &a, const mpm::HostPoints<3, double> &b)
+  {
+    double v_scale = 1e-300, s_scale = 1e-300, worst = 0;
+    for (int i = 0; i < a.size(); ++i)
+      {
+        for (int d = 0; d < 3; ++d)
+          v_scale = std::max(v_scale, std::abs(a.velocity[d][i]));
+        for (int c = 0; c < mpm::n_voigt; ++c)
+          s_scale = std::max(s_scale, std::abs(a.stress[c][i]));
+      }
+    for (int i = 0; i < a.size(); ++i)
+      {
+        if ((a.material[i] < 0) != (b.material[i] < 0))
+          return 1;
+        for (int d = 0; d < 3; ++d)
+          {
+            worst = std::max(worst, std::abs(a.position[d][i] - b.position[d][i]) / mpm_bench::P1::h);
+            worst = std::max(worst, std::abs(a.velocity[d][i] - b.velocity[d][i]) / v_scale);
+          }
+        for (int c = 0; c < mpm::n_voigt; ++c)
+          worst = std::max(worst, std::abs(a.stress[c][i] - b.stress[c][i]) / s_scale);
+        worst = std::max(worst, std::abs(a.volume[i] - b.volume[i]) / a.initial_volume[i]);
+        worst = std::max(worst, std::abs(a.plastic_strain[i] - b.plastic_strain[i]));
+      }
+    return worst;
   }
 } // namespace mpm_test

@@ -8,6 +8,8 @@
 #include <mpm/core/interpolation.h>
 #include <mpm/core/stencil_contribution.h>
 
+#include "targets.h"
+
 namespace mpm_test
 {
   struct SerialAtomicBackend
@@ -17,7 +19,7 @@ namespace mpm_test
     static constexpr bool atomic_scatter = true;
 
     template <int K, typename T>
-    static void add_to_node(T *const *targets, const int entry, const T *values)
+    MPM_HOST_DEVICE static void add_to_node(T *const *targets, const int entry, const T *values)
     {
       for (int k = 0; k < K; ++k)
         targets[k][entry] += values[k];
@@ -25,7 +27,7 @@ namespace mpm_test
 
     // A point's contribution into its stencil (the -DMPM_UNROLL_STENCIL build's path).
     template <int dim, typename Shape, int K, int Kg, typename Real>
-    static void scatter_stencil(const mpm::GridView<dim, Real> &g, const Real x[dim], const Real lp[dim],
+    MPM_HOST_DEVICE static void scatter_stencil(const mpm::GridView<dim, Real> &g, const Real x[dim], const Real lp[dim],
                                 Real *const *targets, const mpm::StencilContribution<dim, K, Kg, Real> &c)
     {
       mpm::add_contribution<SerialAtomicBackend>(
@@ -63,5 +65,14 @@ namespace mpm_test
     }
 
     void synchronize() const {}
+  };
+
+  // A scene on the host (CpuTarget's storage) stepped by the serial atomic backend.
+  template <int dim, typename Real>
+  struct SerialAtomicTarget : CpuTarget<dim, Real>
+  {
+    static constexpr const char *name = "serial atomic";
+    SerialAtomicBackend          backend; // hides CpuTarget's
+    using CpuTarget<dim, Real>::CpuTarget;
   };
 } // namespace mpm_test

@@ -10,7 +10,6 @@
 #include "check.h"
 #include "fused_step_scene.h"
 #include "serial_atomic_backend.h"
-#include "targets.h"
 
 #include <mpm/core/backend/cpu_backend.h>
 
@@ -24,43 +23,6 @@ using namespace mpm_test;
 
 namespace
 {
-  template <int dim, typename Real>
-  struct SerialAtomicTarget : CpuTarget<dim, Real>
-  {
-    static constexpr const char *name = "serial atomic";
-    SerialAtomicBackend          backend;
-    using CpuTarget<dim, Real>::CpuTarget;
-  };
-
-  // Largest difference over the points: positions in cells, velocities and stresses
-  // relative to their largest magnitude; removed points must match.
-  double largest_difference(const HostPoints<3, double> &a, const HostPoints<3, double> &b)
-  {
-    double v_scale = 1e-300, s_scale = 1e-300, worst = 0;
-    for (int i = 0; i < a.size(); ++i)
-      {
-        for (int d = 0; d < 3; ++d)
-          v_scale = std::max(v_scale, std::abs(a.velocity[d][i]));
-        for (int c = 0; c < n_voigt; ++c)
-          s_scale = std::max(s_scale, std::abs(a.stress[c][i]));
-      }
-    for (int i = 0; i < a.size(); ++i)
-      {
-        if ((a.material[i] < 0) != (b.material[i] < 0))
-          return 1;
-        for (int d = 0; d < 3; ++d)
-          {
-            worst = std::max(worst, std::abs(a.position[d][i] - b.position[d][i]) / mpm_bench::P1::h);
-            worst = std::max(worst, std::abs(a.velocity[d][i] - b.velocity[d][i]) / v_scale);
-          }
-        for (int c = 0; c < n_voigt; ++c)
-          worst = std::max(worst, std::abs(a.stress[c][i] - b.stress[c][i]) / s_scale);
-        worst = std::max(worst, std::abs(a.volume[i] - b.volume[i]) / a.initial_volume[i]);
-        worst = std::max(worst, std::abs(a.plastic_strain[i] - b.plastic_strain[i]));
-      }
-    return worst;
-  }
-
   // How far the run went: the largest displacement in cells (the comparison means something
   // only where the points moved and yielded).
   void print_motion(const char *what, const HostPoints<3, double> &p, const HostPoints<3, double> &initial)

@@ -538,7 +538,8 @@ namespace mpm
     MPM_HOST_DEVICE inline void point_to_grid(const GridView<dim, Real> &g, const PointsView<dim, Real> &p,
                                               const StepSettings<dim, Real> &s, const int i,
                                               const bool mass_and_momentum, const bool forces, void *stencils,
-                                              const bool apply_averaging, const MaterialParameters<Real> *disconnecting)
+                                              const bool apply_averaging, const MaterialParameters<Real> *disconnecting,
+                                              const Real *gravity)
     {
       Real x[dim], lp[domain_values<dim, Shape>()], v[dim];
       for (int d = 0; d < dim; ++d)
@@ -577,7 +578,7 @@ namespace mpm
       for (int d = 0; d < dim; ++d)
         {
           all.c_N[1 + d]       = m * v[d];
-          all.c_N[1 + dim + d] = m * s.gravity[d];
+          all.c_N[1 + dim + d] = m * gravity[d];
 #ifndef __CUDA_ARCH__
           if (s.body_force_state_variable >= 0)
             all.c_N[1 + dim + d] += m * p.state_variables[s.body_force_state_variable + d][i];
@@ -649,8 +650,32 @@ namespace mpm
       backend.scatter_points(p.n_points, [=] MPM_HOST_DEVICE(const int i) {
         if (p.material[i] >= 0)
           point_to_grid<Backend, dim, Shape>(g, p, s, i, mass_and_momentum, forces, stencils, apply_averaging,
-                                             disconnecting);
+                                             disconnecting, s.gravity);
       });
+    }
+
+    // A gravity vector by value (a kernel's argument).
+    template <int dim, typename Real>
+    struct Gravity
+    {
+      Real g[dim];
+    };
+
+    // The fused step's P2G of the next step for point i at the end of its kinematics
+    // (grid_to_particle_kinematics with carry_p2g); nothing without. Here and not in the
+    // kinematics' lambda: nvcc's extended lambdas may not capture first inside if constexpr.
+    template <bool carry_p2g, typename Backend, int dim, typename Shape, typename Real>
+    MPM_HOST_DEVICE inline void next_point_to_grid(const GridView<dim, Real> &g, const PointsView<dim, Real> &p,
+                                                   const StepSettings<dim, Real> &s, const int i,
+                                                   const Gravity<dim, Real> &next_gravity)
+    {
+      if constexpr (carry_p2g)
+        point_to_grid<Backend, dim, Shape>(g, p, s, i, true, true, nullptr, false,
+                                           static_cast<const MaterialParameters<Real> *>(nullptr), next_gravity.g);
+      else
+        {
+          (void)g, (void)p, (void)s, (void)i, (void)next_gravity;
+        }
     }
 
     // The affine part of every point's momentum, m N_i C_p (x_i - x_p), in a pass of its own:
@@ -917,14 +942,20 @@ namespace mpm
     }
 
     // The same from a per-point loop other than scatter_points: only where add_to_node is
-    // atomic (grid_to_particle_kinematics refuses the others before it starts).
-    template <typename Backend, int dim, typename Real>
+    // atomic (grid_to_particle_kinematics refuses the others before it starts), and not in the
+    // fused kinematics (compiled = false), which the averaging does not run with: on the device
+    // add_to_node's staging area and the stencil scatter's records do not fit one kernel.
+    template <typename Backend, bool compiled = true, int dim, typename Real>
     MPM_HOST_DEVICE inline void add_cell_pressure_atomically(const GridView<dim, Real> &g,
                                                              const PointsView<dim, Real> &p, const int i,
                                                              const MaterialParameters<Real> *disconnecting)
     {
-      if constexpr (atomic_scatter<Backend>::value)
+      if constexpr (atomic_scatter<Backend>::value && compiled)
         add_cell_pressure<Backend>(g, p, i, disconnecting);
+      else
+        {
+          (void)g, (void)p, (void)i, (void)disconnecting;
+        }
     }
 
     // G2P kinematics from the nodal velocity field, then per point: position,
@@ -933,9 +964,9 @@ namespace mpm
     // The particle domain is rescaled only in the pass that moves the points, so that
     // every transfer of one step uses the same stencil (USF deforms before it moves).
     // carry_p2g (atomic backends only, explicit_step's FusedTransfer): each point's P2G of
-    // the next step too, with next_gravity, after its own update (the grid's mass, momentum
-    // and force zeroed before). A template argument, so that the unfused pass compiles as
-    // before (the fused one holds the stencil scatter's shared records instead of
+    // the next step too, with next_gravity_given, after its own update (the grid's mass,
+    // momentum and force zeroed before). A template argument, so that the unfused pass
+    // compiles as before (the fused one holds the stencil scatter's shared records instead of
     // add_to_node's staging area).
     template <int dim, typename Shape, DevicePhysics physics = DevicePhysics::standard, bool carry_p2g = false,
               typename Real, typename Backend>
@@ -945,21 +976,19 @@ namespace mpm
                                      const StepSettings<dim, Real> &s, const Real dt_given,
                                      const bool move_points, const bool deform_points,
                                      const void *stencils = nullptr, const bool scatter_pressure = false,
-                                     const Real *next_gravity = nullptr)
+                                     const Real *next_gravity_given = nullptr)
     {
       // scatter_pressure (atomic backends only): the first pass of the pressure averaging
       // too, at the end of each point's update (one pass over the points less).
       if constexpr (!atomic_scatter<Backend>::value)
         if (scatter_pressure || carry_p2g)
           throw std::invalid_argument("grid_to_particle_kinematics: this backend scatters only in scatter_points");
-      if (carry_p2g && (scatter_pressure || next_gravity == nullptr))
+      if (carry_p2g && (scatter_pressure || next_gravity_given == nullptr))
         throw std::invalid_argument("grid_to_particle_kinematics: the next step's P2G needs its gravity and no "
                                     "pressure averaging");
-      StepSettings<dim, Real> next = s; // the next P2G's settings (captured only where it runs)
-      if (next_gravity != nullptr)
-        for (int d = 0; d < dim; ++d)
-          next.gravity[d] = next_gravity[d];
-      (void)next;
+      Gravity<dim, Real> next_gravity; // captured by value (the kernel's argument)
+      for (int d = 0; d < dim; ++d)
+        next_gravity.g[d] = next_gravity_given != nullptr ? next_gravity_given[d] : Real(0);
       const MaterialParameters<Real> *disconnecting = disconnecting_materials(s, materials);
       backend.gather_points(p.n_points, [=] MPM_HOST_DEVICE(const int i) {
         if (p.material[i] < 0)
@@ -1115,10 +1144,10 @@ namespace mpm
 
         if (leaves_grid)
           p.material[i] = -1;
-        else if constexpr (carry_p2g)
-          point_to_grid<Backend, dim, Shape, Real>(g, p, next, i, true, true, nullptr, false, nullptr);
         else if (scatter_pressure)
-          add_cell_pressure_atomically<Backend>(g, p, i, disconnecting);
+          add_cell_pressure_atomically<Backend, !carry_p2g>(g, p, i, disconnecting);
+        else
+          next_point_to_grid<carry_p2g, Backend, dim, Shape>(g, p, s, i, next_gravity);
       });
     }
 
