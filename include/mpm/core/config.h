@@ -8,6 +8,10 @@
 #  define MPM_HOST_DEVICE
 #endif
 
+// A per-point body that a loop calls from one place (point_to_grid): inlined there. GCC left
+// it out of line, a call per point and 1% of V3's CPU step (doc/log.md, 2026-12-05).
+#define MPM_ALWAYS_INLINE inline __attribute__((always_inline))
+
 namespace mpm
 {
   // Stress and strain are stored as 6 Voigt-ordered components in 2D as well:

@@ -535,7 +535,7 @@ namespace mpm
     // (-V sigma . grad N) and gravity forces. particles_to_grid runs it for every point; the
     // fused step (explicit_step, FusedTransfer) at the end of each point's kinematics.
     template <typename Backend, int dim, typename Shape, typename Real>
-    MPM_HOST_DEVICE inline void point_to_grid(const GridView<dim, Real> &g, const PointsView<dim, Real> &p,
+    MPM_HOST_DEVICE MPM_ALWAYS_INLINE void point_to_grid(const GridView<dim, Real> &g, const PointsView<dim, Real> &p,
                                               const StepSettings<dim, Real> &s, const int i,
                                               const bool mass_and_momentum, const bool forces, void *stencils,
                                               const bool apply_averaging, const MaterialParameters<Real> *disconnecting,
