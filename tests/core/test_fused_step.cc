@@ -4,7 +4,7 @@
 // order (serial_atomic_backend.h) the adds also come in the same order, so the fused run
 // must equal the unfused one bit for bit: P1 with Drucker-Prager and local damping (the
 // gravity ramped, so a P2G with this step's gravity instead of the next one's differs),
-// MUSL with GIMP and USL with the cubic B-spline. That backend itself is checked against
+// MUSL and USL, every shape function of the 3D step. That backend itself is checked against
 // the CPU backend (the same step, sums in another order: within the round-off of
 // test_gpu_cpu_agreement's bound). The GPU twin is tests/gpu/test_gpu_fused_step.
 #include "check.h"
@@ -38,14 +38,14 @@ namespace
   }
 
   template <typename Shape>
-  void fused_equals_unfused(const char *what, const UpdateScheme scheme)
+  void fused_equals_unfused(const char *what, const UpdateScheme scheme, const long n_steps = 150)
   {
     FusedRun run;
     run.scheme = scheme;
     HostPoints<3, double> unfused, fused, initial;
     run.n_steps = 0;
     p1_fused_or_not<SerialAtomicTarget, Shape>(run, initial);
-    run.n_steps = 150;
+    run.n_steps = n_steps;
     const double t = p1_fused_or_not<SerialAtomicTarget, Shape>(run, unfused);
     run.fused      = true;
     p1_fused_or_not<SerialAtomicTarget, Shape>(run, fused);
@@ -61,6 +61,12 @@ int main()
 {
   fused_equals_unfused<GimpShape>("P1, Drucker-Prager, MUSL, GIMP", UpdateScheme::musl);
   fused_equals_unfused<CubicBSplineShape>("P1, Drucker-Prager, USL, cubic B-spline", UpdateScheme::usl);
+  // The other stencils, fewer steps: the quadratic B-spline, the cubic B-spline GIMP, linear
+  // (MUSL: USL with linear weights blows up here), and CPDI (corner by corner, not a tensor product).
+  fused_equals_unfused<QuadraticBSplineShape>("P1, DP, MUSL, quadratic B-spline", UpdateScheme::musl, 80);
+  fused_equals_unfused<CubicBSplineGimpShape>("P1, DP, MUSL, cubic B-spline GIMP", UpdateScheme::musl, 80);
+  fused_equals_unfused<LinearShape>("P1, DP, MUSL, linear", UpdateScheme::musl, 80);
+  fused_equals_unfused<CpdiShape>("P1, DP, MUSL, CPDI", UpdateScheme::musl, 80);
 
   // The serial atomic backend against the CPU backend: elastic, undamped (no switch that the
   // order of a sum can flip), 100 steps. test_gpu_cpu_agreement's bound for 3D after N steps
