@@ -620,6 +620,11 @@ int main(int argc, char **argv)
                   "--transfer tpic)\n");
       return 2;
     }
+  if (opt.fused && opt.affine)
+    {
+      std::printf("--fused: not with --transfer tpic|apic (the fused step runs the FLIP/PIC blend only)\n");
+      return 2;
+    }
   if (cuda_device_count() == 0)
     {
       std::printf("p1_benchmark: no CUDA device found\n");

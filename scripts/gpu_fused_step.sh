@@ -5,8 +5,8 @@
 #   gpu_fused_step.sh DIR OUTDIR
 # 1. test_gpu_fused_step (fused GPU against the host's unfused step), then compute-sanitizer's
 #    memcheck and racecheck on a small fused P1;
-# 2. P1 rows, unfused and fused in turn (12.8M points, 400 steps; 512,000 points, P2's size,
-#    2000 steps), twice, and each with --profile's per-launch times.
+# 2. P1 rows, unfused and fused in turn (12.8M points, 400 steps; 511,224 points, about P2's
+#    512,000, 2000 steps), twice, then each once with --profile's per-launch times.
 set -u -o pipefail
 dir=$(readlink -f "$1") out=$2
 mkdir -p "$out"

@@ -156,6 +156,8 @@ namespace mpm
   // nothing reads or changes the grid or the points between the two steps other than a
   // re-sort (a permutation of the points leaves the sums as they are): not before an output
   // of the grid, a change of the grid's nodes, points added or removed by the host.
+  // explicit_step throws std::invalid_argument where it cannot fuse: pressure averaging, held
+  // points, affine transfers, USF, or a backend whose scatter is not atomic (the CPU's).
   template <int dim, typename Real>
   struct FusedTransfer
   {
@@ -536,10 +538,11 @@ namespace mpm
     // fused step (explicit_step, FusedTransfer) at the end of each point's kinematics.
     template <typename Backend, int dim, typename Shape, typename Real>
     MPM_HOST_DEVICE MPM_ALWAYS_INLINE void point_to_grid(const GridView<dim, Real> &g, const PointsView<dim, Real> &p,
-                                              const StepSettings<dim, Real> &s, const int i,
-                                              const bool mass_and_momentum, const bool forces, void *stencils,
-                                              const bool apply_averaging, const MaterialParameters<Real> *disconnecting,
-                                              const Real *gravity)
+                                                         const StepSettings<dim, Real> &s, const int i,
+                                                         const bool mass_and_momentum, const bool forces,
+                                                         void *stencils, const bool apply_averaging,
+                                                         const MaterialParameters<Real> *disconnecting,
+                                                         const Real *gravity)
     {
       Real x[dim], lp[domain_values<dim, Shape>()], v[dim];
       for (int d = 0; d < dim; ++d)
@@ -965,9 +968,9 @@ namespace mpm
     // every transfer of one step uses the same stencil (USF deforms before it moves).
     // carry_p2g (atomic backends only, explicit_step's FusedTransfer): each point's P2G of
     // the next step too, with next_gravity_given, after its own update (the grid's mass,
-    // momentum and force zeroed before). A template argument, so that the unfused pass
-    // compiles as before (the fused one holds the stencil scatter's shared records instead of
-    // add_to_node's staging area).
+    // momentum and force zeroed before). A template argument, so that the unfused pass holds
+    // no P2G (and the fused one the stencil scatter's shared records instead of add_to_node's
+    // staging area).
     template <int dim, typename Shape, DevicePhysics physics = DevicePhysics::standard, bool carry_p2g = false,
               typename Real, typename Backend>
     void grid_to_particle_kinematics(Backend &backend, const GridView<dim, Real> &g,
@@ -1532,22 +1535,29 @@ namespace mpm
                                     FusedTransfer<dim, Real> *fused = nullptr)
   {
     if (shape == ShapeFunction::gimp)
-      return explicit_step<dim, GimpShape, physics>(backend, g, p, materials, s, dt, exchange, averaging_pending, fused);
+      return explicit_step<dim, GimpShape, physics>(backend, g, p, materials, s, dt, exchange,
+                                                    averaging_pending, fused);
     if (shape == ShapeFunction::bspline2)
-      return explicit_step<dim, QuadraticBSplineShape, physics>(backend, g, p, materials, s, dt, exchange, averaging_pending, fused);
+      return explicit_step<dim, QuadraticBSplineShape, physics>(backend, g, p, materials, s, dt, exchange,
+                                                                averaging_pending, fused);
     if (shape == ShapeFunction::bspline3)
-      return explicit_step<dim, CubicBSplineShape, physics>(backend, g, p, materials, s, dt, exchange, averaging_pending, fused);
+      return explicit_step<dim, CubicBSplineShape, physics>(backend, g, p, materials, s, dt, exchange,
+                                                            averaging_pending, fused);
     if (shape == ShapeFunction::bspline3_gimp)
-      return explicit_step<dim, CubicBSplineGimpShape, physics>(backend, g, p, materials, s, dt, exchange, averaging_pending, fused);
+      return explicit_step<dim, CubicBSplineGimpShape, physics>(backend, g, p, materials, s, dt, exchange,
+                                                                averaging_pending, fused);
     if (shape == ShapeFunction::cpdi)
-      return explicit_step<dim, CpdiShape, physics>(backend, g, p, materials, s, dt, exchange, averaging_pending, fused);
+      return explicit_step<dim, CpdiShape, physics>(backend, g, p, materials, s, dt, exchange,
+                                                    averaging_pending, fused);
     if (shape == ShapeFunction::cpdi2q)
       {
         if constexpr (dim == 2)
-          return explicit_step<dim, Cpdi2qShape, physics>(backend, g, p, materials, s, dt, exchange, averaging_pending, fused);
+          return explicit_step<dim, Cpdi2qShape, physics>(backend, g, p, materials, s, dt, exchange,
+                                                          averaging_pending, fused);
         else
           throw std::invalid_argument("explicit_step: CPDI2q is two-dimensional");
       }
-    return explicit_step<dim, LinearShape, physics>(backend, g, p, materials, s, dt, exchange, averaging_pending, fused);
+    return explicit_step<dim, LinearShape, physics>(backend, g, p, materials, s, dt, exchange,
+                                                    averaging_pending, fused);
   }
 } // namespace mpm
