@@ -249,7 +249,7 @@ namespace mpm
                       "parallelepiped domain, whose edges follow F, including its rotation and shear) or CPDI2q "
                       "(2D: the same over a quadrilateral whose four corners move with the grid's velocity). "
                       "CPDI and CPDI2q: one MPI rank, Grid/Nodes = all. Cubic B-spline GIMP: one MPI rank; "
-                      "Grid/Nodes = near material needs Active block size >= 2 and, for now, Backend = cpu.");
+                      "Grid/Nodes = near material needs Active block size >= 2.");
     prm.declare_entry("GIMP domain update", "none", Patterns::Selection("none|det F|F_ii|U"),
                       "How GIMP particle domains follow the deformation: none (uGIMP), det F (cpGIMP, "
                       "half-lengths scaled by det(F)^(1/dim)), F_ii (cpGIMP, half-length i scaled by F_ii; exact "
@@ -1072,11 +1072,6 @@ namespace mpm
             material.elastic_law = m.hencky ? ElasticLaw::hencky : ElasticLaw::jaumann_rate;
         method_choice_report = choice.reason;
       }
-    // Not yet run on a GPU (no device was lent when it came in, doc/performance.md): the
-    // device's steps over the kept nodes are checked with the other shapes only.
-    if (backend == "cuda" && shape_function == ShapeFunction::bspline3_gimp && active_block_cells > 0)
-      fail("Grid/Nodes", "'near material' with Shape function = cubic B-spline GIMP runs on the CPU backend "
-                         "for now (not yet checked on a GPU); with Backend = cuda the only allowed value is all.");
     if (backend == "cuda")
       for (unsigned int i = 0; i < materials.size(); ++i)
         {

@@ -15,6 +15,7 @@
 # mass (to the files' single precision). The first scene once more in float (Backend/Precision =
 # float): its particles and grid files within 10 times the difference between its two runs with every
 # node (float's round-off in sums of no fixed order: about 1e-5 of the stresses after 0.1 s), or 1e-6.
+# And the first scene with the cubic B-spline GIMP (its stencil two cells out of a point's cell), to 1e-10.
 #   nodes_near_material_cuda.sh EXE OUTDIR
 set -eu
 exe=$1 out=$2
@@ -75,3 +76,5 @@ scene one_body all 1e-10
 scene two_bodies none 1e-10 "${second_body[@]}"
 # In float (Backend/Precision): float's round-off in sums of no fixed order, 6e-8 per operation.
 scene one_body_float all spread "subsection Backend" "  set Precision = float" "end"
+# The cubic B-spline GIMP (its stencil reaches two cells out of the point's cell).
+scene one_body_bspline3_gimp all 1e-10 "subsection Solver" "  set Shape function = cubic B-spline GIMP" "end"
