@@ -158,6 +158,8 @@ namespace mpm
   // of the grid, a change of the grid's nodes, points added or removed by the host.
   // explicit_step throws std::invalid_argument where it cannot fuse: pressure averaging, held
   // points, affine transfers, USF, or a backend whose scatter is not atomic (the CPU's).
+  // On an H100 it made P1's step slower (0.91x at 12.8M points; doc/performance.md), so
+  // DeviceEngine does not use it; p1_benchmark --fused measures it.
   template <int dim, typename Real>
   struct FusedTransfer
   {
