@@ -5,7 +5,7 @@
 # Compute: duration, DRAM bytes, how busy each unit was against its peak (DRAM, L2, L1,
 # the SMs' issue), L2 reductions, local-memory (spill) traffic, occupancy, registers.
 # Output in $OUT (default ./output-gpu-counters); the summary is counters.md.
-#   scripts/gpu_p1_counters.sh            SIZE=2560 (12,830,720 points), EXTRA="--fp32" etc.
+#   scripts/gpu_p1_counters.sh            SIZE=2560 (12,830,720 points), EXTRA="--fp32", P1_BIN=FILE[.xz] etc.
 set -u -o pipefail
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
 OUT=${OUT:-$ROOT/output-gpu-counters}
@@ -15,10 +15,17 @@ EXTRA=${EXTRA:-}
 mkdir -p "$OUT"
 export PATH=/usr/local/cuda/bin:$PATH
 nvidia-smi --query-gpu=name,driver_version,clocks.max.sm,clocks.max.mem --format=csv,noheader | tee "$OUT/machine.txt"
-cmake -S "$ROOT" -B "$BUILD" -DMPM_CORE_ONLY=ON -DMPM_WITH_CUDA=ON -DCMAKE_BUILD_TYPE=Release \
-  -DCMAKE_CUDA_ARCHITECTURES=90 >"$OUT/build.log" 2>&1 &&
-  cmake --build "$BUILD" --target p1_benchmark -j "$(nproc)" >>"$OUT/build.log" 2>&1 || { tail -30 "$OUT/build.log"; exit 1; }
-B="$BUILD/benchmarks/p1_benchmark"
+# P1_BIN: a p1_benchmark built elsewhere (the build takes minutes of device time), or its .xz.
+if [ -n "${P1_BIN:-}" ]; then
+  B=$P1_BIN
+  case $B in *.xz) python3 -c "import lzma,shutil,sys; shutil.copyfileobj(lzma.open(sys.argv[1]), open(sys.argv[2],'wb'))" "$B" /tmp/p1_benchmark &&
+    chmod +x /tmp/p1_benchmark && B=/tmp/p1_benchmark ;; esac
+else
+  cmake -S "$ROOT" -B "$BUILD" -DMPM_CORE_ONLY=ON -DMPM_WITH_CUDA=ON -DCMAKE_BUILD_TYPE=Release \
+    -DCMAKE_CUDA_ARCHITECTURES=90 >"$OUT/build.log" 2>&1 &&
+    cmake --build "$BUILD" --target p1_benchmark -j "$(nproc)" >>"$OUT/build.log" 2>&1 || { tail -30 "$OUT/build.log"; exit 1; }
+  B="$BUILD/benchmarks/p1_benchmark"
+fi
 
 # Timed run (the benchmark also measures the device-to-device copy bandwidth).
 [ "${TIMED:-1}" = 1 ] &&
