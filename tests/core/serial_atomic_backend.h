@@ -26,7 +26,7 @@ namespace mpm_test
     }
 
     // A point's contribution into its stencil (the -DMPM_UNROLL_STENCIL build's path).
-    template <int dim, typename Shape, int K, int Kg, typename Real>
+    template <int dim, typename Shape, bool only_scatter_of_kernel = false, int K, int Kg, typename Real>
     MPM_HOST_DEVICE static void scatter_stencil(const mpm::GridView<dim, Real> &g, const Real x[dim], const Real lp[dim],
                                 Real *const *targets, const mpm::StencilContribution<dim, K, Kg, Real> &c)
     {

@@ -897,7 +897,7 @@ namespace mpm
             momentum.c_N[d] = mv[d];
           }
 #if defined(__CUDA_ARCH__) || defined(MPM_UNROLL_STENCIL)
-        Backend::template scatter_stencil<dim, Shape>(g, x, lp, targets, momentum);
+        Backend::template scatter_stencil<dim, Shape, true>(g, x, lp, targets, momentum); // the kernel's only one
         const PointStencil<dim, Shape, Real> affine_stencil{x, lp};
 #else
         add_contribution<Backend>(stencil, targets, momentum);

@@ -73,7 +73,7 @@ namespace mpm
     // A point's contribution into each node of its stencil (step.h: device code and the
     // -DMPM_UNROLL_STENCIL build; the default host stages use the point's HostStencil
     // with add_contribution directly).
-    template <int dim, typename Shape, int K, int Kg, typename Real>
+    template <int dim, typename Shape, bool only_scatter_of_kernel = false, int K, int Kg, typename Real>
     MPM_HOST_DEVICE static void scatter_stencil(const GridView<dim, Real> &g, const Real x[dim], const Real lp[dim],
                                                 Real *const *targets, const StencilContribution<dim, K, Kg, Real> &c)
     {

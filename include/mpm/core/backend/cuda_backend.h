@@ -119,17 +119,18 @@ namespace mpm
     }
 
     // Shared memory where the lanes of a block stage their stencil records for
-    // CudaBackend::scatter_stencil: up to max_record_values per lane (3D GIMP P2G: 34),
-    // max_stencil_threads lanes, 16-byte aligned for paired loads; and per warp a table
-    // of its runs (head lane, length, first stencil node). One of each per kernel,
-    // whichever scatters it instantiates.
+    // CudaBackend::scatter_stencil: capacity values per lane (max_record_values, 3D GIMP
+    // P2G: 34, unless the kernel's only scatter asks for its own record's length),
+    // max_stencil_threads lanes, 16-byte aligned for paired loads; and per warp a table of
+    // its runs (head lane, length, first stencil node). One array per capacity that a
+    // kernel instantiates: the scatters of one kernel (P2G's three forms) share the largest.
     constexpr int max_stencil_threads = 128;
     constexpr int max_record_values   = 34;
     constexpr int run_entry_ints      = 5; // head, length, first[3]
-    template <typename Real>
+    template <typename Real, int capacity = max_record_values>
     __device__ inline Real *stencil_records()
     {
-      __shared__ alignas(16) Real records[max_stencil_threads * max_record_values];
+      __shared__ alignas(16) Real records[max_stencil_threads * capacity];
       return records;
     }
     __device__ inline int *stencil_runs()
@@ -268,12 +269,16 @@ namespace mpm
     // CPDI (not a tensor product: corner by corner, cpdi.h) adds visit by visit through
     // add_to_node, so that neighbouring lanes whose corners fall in the same cell sum their
     // values before the atomic (sorted points share most of them).
-    template <int dim, typename Shape, int K, int Kg, typename Real>
+    // only_scatter_of_kernel: the kernel stages no other record, so its shared array is
+    // sized to this one. MUSL's remap (3D GIMP: 14 values, 14 KB a block against 34 KB):
+    // shared memory had held it to 6 blocks per SM where its registers allow 7; P1's remap
+    // went from 2.93 to 2.65 ms at 12.8M points (H100, doc/performance.md).
+    template <int dim, typename Shape, bool only_scatter_of_kernel = false, int K, int Kg, typename Real>
     MPM_HOST_DEVICE static void scatter_stencil(const GridView<dim, Real> &g, const Real x[dim], const Real lp[dim],
                                                 Real *const *targets, const StencilContribution<dim, K, Kg, Real> &c)
     {
       if constexpr (Shape::tensor_product)
-        scatter_tensor_stencil<dim, Shape>(g, x, lp, targets, c);
+        scatter_tensor_stencil<dim, Shape, only_scatter_of_kernel>(g, x, lp, targets, c);
       else
         for_each_stencil_node<dim, Shape>(g, x, lp, [&](const int node, const Real N, const Real *grad) {
           Real values[K];
@@ -282,7 +287,7 @@ namespace mpm
         });
     }
 
-    template <int dim, typename Shape, int K, int Kg, typename Real>
+    template <int dim, typename Shape, bool only_scatter_of_kernel, int K, int Kg, typename Real>
     MPM_HOST_DEVICE static void scatter_tensor_stencil(const GridView<dim, Real> &g, const Real x[dim],
                                                        const Real lp[dim], Real *const *targets,
                                                        const StencilContribution<dim, K, Kg, Real> &c)
@@ -342,7 +347,8 @@ namespace mpm
             entry[2 + d] = first[d];
         }
 
-      Real *records = cuda_detail::stencil_records<Real>() + (threadIdx.x & ~31u) * stride;
+      constexpr int capacity = !only_scatter_of_kernel ? cuda_detail::max_record_values : staged ? stride : 1;
+      Real *records = cuda_detail::stencil_records<Real, capacity>() + (threadIdx.x & ~31u) * stride;
       Real *mine    = records + lane * stride;
       for (int d = 0; d < dim; ++d)
         for (int j = 0; j < n; ++j)
