@@ -10,11 +10,8 @@
 set -u -o pipefail
 dir=$(readlink -f "$1") out=$2
 mkdir -p "$out"
-for xz in "$dir"/*.xz; do
-  [ -f "$xz" ] || continue
-  target=$dir/$(basename "$xz" .xz)
-  [ -e "$target" ] || python3 -c "import lzma,shutil,sys; shutil.copyfileobj(lzma.open(sys.argv[1]), open(sys.argv[2],'wb'))" "$xz" "$target"
-done
+. "$(dirname "$0")/gpu_unpack_build.sh"
+unxz_beside "$dir"
 chmod +x "$dir"/p1_benchmark "$dir"/test_gpu_fused_step 2>/dev/null
 export LD_LIBRARY_PATH=$dir${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}
 CS=$(ls -d /usr/local/cuda*/bin 2>/dev/null | head -1)/compute-sanitizer

@@ -2,7 +2,7 @@
 # On the GPU machine: where P2's step (prm/granular_collapse_3d.prm on Backend = cuda, 512,000 points)
 # spends its time, launch by launch, through the real dealii-mpm: per-launch CUDA events
 # (MPM_CUDA_KERNEL_TIMES) in a short run, then the hardware counters of one step's launches from
-# about step 300 on with Nsight Compute (the metrics of gpu_p1_counters.sh, whose summary it reuses).
+# about step 300 on with Nsight Compute (ncu_step_metrics.sh, summed up by ncu_step_table.py).
 # Steps are launched one kernel at a time (Queue steps = false) so that the profiler sees each.
 #   . /opt/dl/dl-env.sh && BIN=DIR bash scripts/gpu_p2_counters.sh OUTDIR
 # DIR as for gpu_prm_checks.sh (dealii-mpm and its library or the library's .xz).
@@ -25,17 +25,12 @@ echo "== timed run: rc $?"
 grep -iE "launch|engine step|done, t =" "$out/p2_timed.log" | cut -c1-300
 
 # Counters: skip the launches of about 300 steps (about 10 per step with the re-sorts), then 30.
-M=gpu__time_duration.sum,dram__bytes_read.sum,dram__bytes_write.sum
-M=$M,dram__throughput.avg.pct_of_peak_sustained_elapsed,lts__throughput.avg.pct_of_peak_sustained_elapsed
-M=$M,l1tex__throughput.avg.pct_of_peak_sustained_elapsed,sm__throughput.avg.pct_of_peak_sustained_elapsed
-M=$M,smsp__issue_active.avg.pct_of_peak_sustained_elapsed,lts__t_sectors_op_red.sum,lts__t_sectors_op_atom.sum
-M=$M,lts__t_sector_hit_rate.pct,l1tex__t_sectors_pipe_lsu_mem_local_op_ld.sum,l1tex__t_sectors_pipe_lsu_mem_local_op_st.sum
-M=$M,sm__warps_active.avg.pct_of_peak_sustained_active,launch__registers_per_thread
+. "$here/ncu_step_metrics.sh"
 prm 0.03
 start=$(date +%s)
-timeout 400 ncu --kernel-name regex:"for_each_kernel|gather_kernel_bounded|reduce_|launch_kernel" \
+timeout 400 ncu --kernel-name regex:"for_each_kernel|gather_kernel_bounded|reduce_" \
   --launch-skip "${SKIP:-3000}" --launch-count "${COUNT:-30}" --clock-control none --print-units base \
-  --metrics "$M" --csv "$exe" /tmp/p2c.prm >"$out/ncu.csv" 2>"$out/ncu.err"
+  --metrics "$NCU_STEP_METRICS" --csv "$exe" /tmp/p2c.prm >"$out/ncu.csv" 2>"$out/ncu.err"
 echo "== ncu: rc $? ($(($(date +%s) - start)) s)"
 tail -3 "$out/ncu.err"
-grep -c "gpu__time_duration" "$out/ncu.csv"
+python3 "$here/ncu_step_table.py" "$out/ncu.csv" "P2 (512,000 points)" | tee "$out/counters.md"

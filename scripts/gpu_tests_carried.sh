@@ -7,12 +7,9 @@
 set -u -o pipefail
 dir=$(readlink -f "$1") out=$2
 mkdir -p "$out"
-for xz in "$dir"/*.xz; do
-  [ -f "$xz" ] || continue
-  target=$dir/$(basename "$xz" .xz)
-  [ -e "$target" ] || python3 -c "import lzma,shutil,sys; shutil.copyfileobj(lzma.open(sys.argv[1]), open(sys.argv[2],'wb'))" "$xz" "$target"
-  chmod +x "$target"
-done
+. "$(dirname "$0")/gpu_unpack_build.sh"
+unxz_beside "$dir"
+chmod +x "$dir"/test_gpu_*
 { nvidia-smi --query-gpu=name,driver_version --format=csv,noheader; date -u; } | tee "$out/machine.txt"
 status=0
 for t in "$dir"/test_gpu_*; do

@@ -1,7 +1,8 @@
-# Sourced by the GPU scripts: unpack_build DIR makes a build folder carried to the GPU machine
-# runnable: each FILE.xz in it is decompressed beside it (libdeal.ii*.xz into $DL/lib, the unpacked
-# deal.II runtime, default /opt/dl), and dealii-mpm made executable.
-unpack_build() {
+# Sourced by the GPU scripts. unxz_beside DIR: each FILE.xz in DIR decompressed beside it, unless there
+# already (libdeal.ii*.xz into $DL/lib, the unpacked deal.II runtime, default /opt/dl; the device's
+# python3 has lzma where xz may be missing). unpack_build DIR makes a build folder carried to the GPU
+# machine runnable: unxz_beside DIR, and dealii-mpm made executable.
+unxz_beside() {
   local dir=$1 xz target
   for xz in "$dir"/*.xz; do
     [ -f "$xz" ] || continue
@@ -9,7 +10,10 @@ unpack_build() {
     case $(basename "$xz") in libdeal.ii*) target=${DL:-/opt/dl}/lib/$(basename "$xz" .xz) ;; esac
     [ -e "$target" ] || python3 -c "import lzma,shutil,sys; shutil.copyfileobj(lzma.open(sys.argv[1]), open(sys.argv[2],'wb'))" "$xz" "$target"
   done
-  chmod +x "$dir/dealii-mpm"
+}
+unpack_build() {
+  unxz_beside "$1"
+  chmod +x "$1/dealii-mpm"
 }
 
 # prepare_build DIR OUT: unpack_build DIR, put DIR first on the library path, let a singleton start without
