@@ -25,7 +25,8 @@ namespace mpm_test
         targets[k][entry] += values[k];
     }
 
-    // A point's contribution into its stencil (the -DMPM_UNROLL_STENCIL build's path).
+    // A point's contribution into its stencil (the -DMPM_UNROLL_STENCIL build's path);
+    // only_scatter_of_kernel sizes the CUDA backend's shared records, nothing here.
     template <int dim, typename Shape, bool only_scatter_of_kernel = false, int K, int Kg, typename Real>
     MPM_HOST_DEVICE static void scatter_stencil(const mpm::GridView<dim, Real> &g, const Real x[dim], const Real lp[dim],
                                 Real *const *targets, const mpm::StencilContribution<dim, K, Kg, Real> &c)

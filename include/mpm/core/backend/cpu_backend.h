@@ -72,7 +72,8 @@ namespace mpm
 
     // A point's contribution into each node of its stencil (step.h: device code and the
     // -DMPM_UNROLL_STENCIL build; the default host stages use the point's HostStencil
-    // with add_contribution directly).
+    // with add_contribution directly). only_scatter_of_kernel: the CUDA backend's sizing
+    // of its shared records (cuda_backend.h); nothing to size here.
     template <int dim, typename Shape, bool only_scatter_of_kernel = false, int K, int Kg, typename Real>
     MPM_HOST_DEVICE static void scatter_stencil(const GridView<dim, Real> &g, const Real x[dim], const Real lp[dim],
                                                 Real *const *targets, const StencilContribution<dim, K, Kg, Real> &c)
