@@ -14,6 +14,7 @@
 #include <mpm/core/local_damping.h>
 #include <mpm/core/stencil_contribution.h>
 #include <mpm/core/material/material.h>
+#include <mpm/core/prefetch.h>
 #include <mpm/core/shape_functions.h>
 #include <mpm/core/small_tensor.h>
 #include <mpm/core/views.h>
@@ -963,6 +964,29 @@ namespace mpm
         }
     }
 
+    // The entries of point i that its kinematics reads only after storing its new position
+    // (the compiler may not move those loads above the store): asked into L2 before the
+    // stencil's gather, so that they arrive while it runs instead of one DRAM round trip
+    // after another. The device only (prefetch.h); no effect on any result.
+    template <int dim, typename Real>
+    MPM_HOST_DEVICE inline void prefetch_constitutive_state(const PointsView<dim, Real> &p,
+                                                            const StepSettings<dim, Real> &s, const int i)
+    {
+      for (int k = 0; k < dim * dim; ++k)
+        prefetch_to_l2(p.deformation_gradient[k] + i);
+      prefetch_to_l2(p.volume + i);
+      prefetch_to_l2(p.initial_volume + i);
+      for (int c = 0; c < n_voigt; ++c)
+        {
+          prefetch_to_l2(p.stress[c] + i);
+          prefetch_to_l2(p.strain[c] + i);
+        }
+      prefetch_to_l2(p.plastic_strain + i);
+      if (s.domain_update != DomainUpdate::none)
+        for (int d = 0; d < dim; ++d)
+          prefetch_to_l2(p.initial_domain_half_length[d] + i);
+    }
+
     // G2P kinematics from the nodal velocity field, then per point: position,
     // strain and spin increments, volume and particle domain, constitutive update.
     // A point whose centre leaves the grid is marked removed (material = -1).
@@ -1004,6 +1028,10 @@ namespace mpm
         for (int d = 0; d < dim; ++d)
           x[d] = p.position[d][i];
         load_domain<dim, Shape>(p, s, i, lp);
+#if !defined(MPM_NO_PREFETCH)
+        if (deform_points)
+          prefetch_constitutive_state(p, s, i);
+#endif
         auto visit = [&](const int n, const Real N, const Real *grad) {
           for (int d = 0; d < dim; ++d)
             {
@@ -1027,6 +1055,17 @@ namespace mpm
         // largest live state of the kernel (the CUDA gathers run under a register cap).
         bool       leaves_grid = false;
         const bool move        = move_points && !s.hold_points;
+        // GIMP's domain from the point's F and J (domain_update.h), after both are updated.
+        auto rescale_domain = [&](const Real *f, const Real J) {
+          Real scale[dim];
+          gimp_domain_scale<dim>(s.domain_update, f, J, scale);
+          for (int d = 0; d < dim; ++d)
+            {
+              // GIMP weights are valid up to half a cell.
+              const Real l = p.initial_domain_half_length[d][i] * scale[d];
+              p.domain_half_length[d][i] = l < Real(0.5) * g.h ? l : Real(0.5) * g.h;
+            }
+        };
         if (move)
           for (int d = 0; d < dim; ++d)
             {
@@ -1066,7 +1105,9 @@ namespace mpm
             kinematics.d_eps  = d_eps;
             kinematics.d_spin = dW;
             kinematics.f      = dF;
-            kinematics.J      = p.volume[i] / p.initial_volume[i]; // before the update below
+            const Real initial_volume = p.initial_volume[i];
+            Real       volume         = p.volume[i];
+            kinematics.J              = volume / initial_volume; // before the update below
             // F <- (I + L dt) F; the volume by det(I + L dt), whose product over the steps is
             // det F: computed from F it would lose its digits where F is far from a rotation
             // (a point sheared along a no-slip base: entries of thousands, det F of a few, and
@@ -1081,9 +1122,20 @@ namespace mpm
                 for (int a = 0; a < dim; ++a)
                   for (int b = 0; b < dim; ++b)
                     p.deformation_gradient[a * dim + b][i] = F.a[a][b];
-                p.volume[i] *= determinant(dF);
+                volume *= determinant(dF);
+                p.volume[i] = volume;
+                // The domain here, from F and the volume still in registers (reading them back
+                // would wait on the stores above); move implies !hold_points.
+                if (s.domain_update != DomainUpdate::none && move)
+                  {
+                    Real f[dim * dim];
+                    for (int a = 0; a < dim; ++a)
+                      for (int b = 0; b < dim; ++b)
+                        f[a * dim + b] = F.a[a][b];
+                    rescale_domain(f, volume / initial_volume);
+                  }
               }
-            kinematics.J_new = p.volume[i] / p.initial_volume[i];
+            kinematics.J_new = volume / initial_volume;
             MaterialPointState<Real> state;
             for (int c = 0; c < n_voigt; ++c)
               state.stress[c] = p.stress[c][i];
@@ -1114,18 +1166,12 @@ namespace mpm
 #endif
           }
 
-        if (s.domain_update != DomainUpdate::none && move)
+        if (s.domain_update != DomainUpdate::none && move && !deform_points)
           {
-            Real f[dim * dim], scale[dim];
+            Real f[dim * dim];
             for (int k = 0; k < dim * dim; ++k)
               f[k] = p.deformation_gradient[k][i];
-            gimp_domain_scale<dim>(s.domain_update, f, p.volume[i] / p.initial_volume[i], scale);
-            for (int d = 0; d < dim; ++d)
-              {
-                // GIMP weights are valid up to half a cell.
-                const Real l = p.initial_domain_half_length[d][i] * scale[d];
-                p.domain_half_length[d][i] = l < Real(0.5) * g.h ? l : Real(0.5) * g.h;
-              }
+            rescale_domain(f, p.volume[i] / p.initial_volume[i]);
           }
 
         if constexpr (Shape::tracks_corners)
