@@ -20,6 +20,7 @@
 #include <mpm/core/views.h>
 
 #include <cmath>
+#include <type_traits>
 
 #if defined(__CUDA_ARCH__)
 #  define MPM_UNROLL _Pragma("unroll")
@@ -291,41 +292,63 @@ namespace mpm
       for (int k = 0; k < n; ++k)
         dw[d][k] *= inv_h;
 
-    if constexpr (dim == 3)
-      {
-        MPM_UNROLL
-        for (int kz = 0; kz < n; ++kz)
+    // checked: each node looked up and skipped where absent. Unchecked where the lattice is
+    // dense (no node table) and the whole stencil inside it, as for nearly every point: every
+    // node is base + offset and none is skipped, so the unrolled loop has no branch per node
+    // and the loads of a gather over all its nodes can be in flight together (behind a
+    // branch each had to wait for the one before). The same nodes, order and arithmetic.
+    auto visit_nodes = [&](auto checked) {
+      auto node_of = [&](const int k[dim]) {
+        if constexpr (decltype(checked)::value)
+          return node_at(k);
+        else
+          {
+            long offset = 0;
+            for (int d = 0; d < dim; ++d)
+              offset += k[d] * stride[d];
+            return static_cast<int>(base + offset);
+          }
+      };
+      if constexpr (dim == 3)
+        {
+          MPM_UNROLL
+          for (int kz = 0; kz < n; ++kz)
+            MPM_UNROLL
+            for (int ky = 0; ky < n; ++ky)
+              {
+                const Real w_yz = w[1][ky] * w[2][kz], dw_y = dw[1][ky] * w[2][kz], dw_z = w[1][ky] * dw[2][kz];
+                MPM_UNROLL
+                for (int kx = 0; kx < n; ++kx)
+                  {
+                    const int k[3] = {kx, ky, kz};
+                    const int node = node_of(k);
+                    if (decltype(checked)::value && node < 0)
+                      continue;
+                    const Real grad[3] = {dw[0][kx] * w_yz, w[0][kx] * dw_y, w[0][kx] * dw_z};
+                    visit(node, w[0][kx] * w_yz, grad);
+                  }
+              }
+        }
+      else
+        {
           MPM_UNROLL
           for (int ky = 0; ky < n; ++ky)
-            {
-              const Real w_yz = w[1][ky] * w[2][kz], dw_y = dw[1][ky] * w[2][kz], dw_z = w[1][ky] * dw[2][kz];
-              MPM_UNROLL
-              for (int kx = 0; kx < n; ++kx)
-                {
-                  const int k[3]  = {kx, ky, kz};
-                  const int node = node_at(k);
-                  if (node < 0)
-                    continue;
-                  const Real grad[3] = {dw[0][kx] * w_yz, w[0][kx] * dw_y, w[0][kx] * dw_z};
-                  visit(node, w[0][kx] * w_yz, grad);
-                }
-            }
-      }
+            MPM_UNROLL
+            for (int kx = 0; kx < n; ++kx)
+              {
+                const int k[2] = {kx, ky};
+                const int node = node_of(k);
+                if (decltype(checked)::value && node < 0)
+                  continue;
+                const Real grad[2] = {dw[0][kx] * w[1][ky], w[0][kx] * dw[1][ky]};
+                visit(node, w[0][kx] * w[1][ky], grad);
+              }
+        }
+    };
+    if (inside && grid.lattice_to_node == nullptr)
+      visit_nodes(std::false_type());
     else
-      {
-        MPM_UNROLL
-        for (int ky = 0; ky < n; ++ky)
-          MPM_UNROLL
-          for (int kx = 0; kx < n; ++kx)
-            {
-              const int k[2]  = {kx, ky};
-              const int node = node_at(k);
-              if (node < 0)
-                continue;
-              const Real grad[2] = {dw[0][kx] * w[1][ky], w[0][kx] * dw[1][ky]};
-              visit(node, w[0][kx] * w[1][ky], grad);
-            }
-      }
+      visit_nodes(std::true_type());
 #endif
       }
   }

@@ -1057,12 +1057,14 @@ namespace mpm
         const bool move        = move_points && !s.hold_points;
         // GIMP's domain from the point's F and J (domain_update.h), after both are updated.
         auto rescale_domain = [&](const Real *f, const Real J) {
-          Real scale[dim];
+          Real scale[dim], initial[dim]; // every load before the first store, as below
+          for (int d = 0; d < dim; ++d)
+            initial[d] = p.initial_domain_half_length[d][i];
           gimp_domain_scale<dim>(s.domain_update, f, J, scale);
           for (int d = 0; d < dim; ++d)
             {
               // GIMP weights are valid up to half a cell.
-              const Real l = p.initial_domain_half_length[d][i] * scale[d];
+              const Real l = initial[d] * scale[d];
               p.domain_half_length[d][i] = l < Real(0.5) * g.h ? l : Real(0.5) * g.h;
             }
         };
@@ -1154,10 +1156,15 @@ namespace mpm
             else
               update_stress<all_physics_compiled<physics>()>(with_field_value(material, p.material_field[i]),
                                                              kinematics, state);
+            // Every strain read before any store: a store may alias a later load, which would
+            // then wait for it (on the device one memory round trip per component).
+            Real strain[n_voigt];
+            for (int c = 0; c < n_voigt; ++c)
+              strain[c] = p.strain[c][i] + d_eps[c];
             for (int c = 0; c < n_voigt; ++c)
               {
                 p.stress[c][i] = state.stress[c];
-                p.strain[c][i] += d_eps[c];
+                p.strain[c][i] = strain[c];
               }
             p.plastic_strain[i] = state.plastic_strain;
 #ifndef __CUDA_ARCH__
