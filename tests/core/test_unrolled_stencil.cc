@@ -1,9 +1,10 @@
-// The device's form of the stencil loop (interpolation.h: unrolled, each node from the point's
-// base index where the stencil lies inside the lattice), compiled here on the host with
+// The device's form of the stencil loop (interpolation.h: unrolled, and without a check per
+// node where the lattice is dense and the stencil inside it), compiled here on the host with
 // -DMPM_UNROLL_STENCIL, against the host's HostStencil: the same nodes in the same order, N and
 // grad N equal to round-off (their products come in another order), for every tensor-product
 // shape, 2D and 3D, on three numberings of the nodes:
-// - the whole lattice without a table (interior points and points near a face);
+// - the whole lattice without a table (interior points take the unchecked loop, points near
+//   a face the checked one);
 // - a box of the lattice without a table (stencils that leave the box are checked);
 // - a table with absent nodes (always checked).
 // Where the whole stencil is present, the weights of the unrolled form reproduce linear
