@@ -63,11 +63,11 @@ namespace
     ShapeFunction    shape          = ShapeFunction::gimp;
     DomainUpdate     domain         = DomainUpdate::det_F; // GIMP's; P1's own is det F
     // --transfer tpic|apic: an affine transfer instead of P1's FLIP/PIC blend; --law hencky.
-    // Either runs the step's kernels that hold them (DevicePhysics::all).
+    // Either, or --domain U, runs the step's kernels that hold them (DevicePhysics::all).
     bool             affine   = false;
     AffineMatrix     affine_matrix = AffineMatrix::velocity_gradient;
     bool             hencky   = false;
-    bool             all_physics() const { return affine || hencky; }
+    bool             all_physics() const { return affine || hencky || domain == DomainUpdate::U; }
     long             launch_mode_steps = 0;
     bool             fused             = false;
   };

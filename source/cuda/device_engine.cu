@@ -418,16 +418,6 @@ namespace mpm
         });
       }
 
-      // Whether a material of the table asks for Hencky's law (its kernels are the step's
-      // DevicePhysics::all variant).
-      inline bool uses_hencky(const std::vector<MaterialParameters<double>> &materials)
-      {
-        for (const MaterialParameters<double> &m : materials)
-          if (m.elastic_law == ElasticLaw::hencky)
-            return true;
-        return false;
-      }
-
       // Whether a material of the table disconnects points (material.h): the averaging
       // finished outside a step then leaves them out, as the step does.
       inline bool disconnects_points(const std::vector<MaterialParameters<double>> &materials)
@@ -696,8 +686,9 @@ namespace mpm
       long                         n_lattice_cells = 1;
       HostLattice<dim>             host_lattice;
       ShapeFunction                shape;
-      // A material asks for Hencky's law: the step runs the kernels that hold it.
-      bool                         hencky = false;
+      // A material asks for Hencky's law or Mohr-Coulomb: the step runs the kernels that hold
+      // them (step.h's DevicePhysics).
+      bool                         all_laws = false;
       // A material disconnects points (disconnects_points).
       bool                         disconnects = false;
       Staging<int, Real>           exchanged_nodes;
@@ -868,7 +859,7 @@ namespace mpm
         }
       impl->grid.set_box(slab_lower, slab_nodes);
       impl->materials.upload(converted<Real>(materials));
-      impl->hencky      = uses_hencky(materials);
+      impl->all_laws    = materials_need_all_physics(materials);
       impl->disconnects = disconnects_points(materials);
       impl->exchange = ExchangeAdapter<Real>{exchange, &impl->backend, &impl->exchanged_nodes, &impl->exchanged_cells};
       if (exchange != nullptr)
@@ -1078,7 +1069,7 @@ namespace mpm
       append_key(key, impl->points.view());
       append_key(key, impl->materials.data());
       append_key(key, impl->shape);
-      append_key(key, impl->hencky);
+      append_key(key, impl->all_laws);
       append_key(key, impl->disconnects);
       append_key(key, impl->averaging_pending);
       append_key(key, impl->backend.block_size);
@@ -1211,7 +1202,7 @@ namespace mpm
       if (s.affine_state_variable >= 0 && impl->points.n_state_variables() < s.affine_state_variable + dim * dim)
         throw std::invalid_argument("DeviceEngine::step: the affine transfers need the points uploaded with their "
                                     "affine matrices (dim x dim state variables)");
-      const bool all_physics = impl->hencky || s.affine_state_variable >= 0;
+      const bool all_physics = impl->all_laws || settings_need_all_physics(s);
       const StepReduction<Real> r =
         all_physics ? explicit_step<dim, DevicePhysics::all>(impl->backend, impl->shape, g, impl->points.view(),
                                                               impl->materials.data(), s, dt, impl->exchange,
@@ -1253,7 +1244,7 @@ namespace mpm
     {
       impl->backend.synchronize(); // the table may be in use by a launch in flight
       impl->materials.upload(converted<Real>(materials));
-      impl->hencky      = uses_hencky(materials);
+      impl->all_laws    = materials_need_all_physics(materials);
       impl->disconnects = disconnects_points(materials);
     }
 

@@ -127,8 +127,8 @@ namespace mpm_test
         {
           const double dt = std::min(0.5 * h / (c + max_speed), t_end - time);
           const auto   pv = target.template points_at_step<Shape>(r.n_steps);
-          // The affine transfers: on the device, the step's kernels that hold them.
-          max_speed = (transfer.apic ?
+          // The affine transfers and U's domains: on the device, the step's kernels that hold them.
+          max_speed = (transfer.apic || update == DomainUpdate::U ?
                          explicit_step<dim, Shape, DevicePhysics::all>(target.backend, gv, pv, target.material_table(),
                                                                        s, dt) :
                          explicit_step<dim, Shape>(target.backend, gv, pv, target.material_table(), s, dt))

@@ -65,16 +65,19 @@ namespace mpm
       }
   }
 
-  // scale[d]: the factor on the initial half-length along axis d; j = det F.
-  template <int dim, typename Real>
+  // scale[d]: the factor on the initial half-length along axis d; j = det F. with_u = false
+  // leaves U's eigen decomposition out of the compiled code (the device's standard kernels,
+  // step.h's DevicePhysics; explicit_step refuses U there).
+  template <int dim, bool with_u = true, typename Real>
   MPM_HOST_DEVICE inline void gimp_domain_scale(const DomainUpdate update, const Real *f, const Real j,
                                                 Real scale[dim])
   {
-    if (update == DomainUpdate::U)
-      {
-        right_stretch_diagonal<dim>(f, scale);
-        return;
-      }
+    if constexpr (with_u)
+      if (update == DomainUpdate::U)
+        {
+          right_stretch_diagonal<dim>(f, scale);
+          return;
+        }
     const Real iso = dim == 2 ? std::sqrt(j) : std::cbrt(j);
     for (int d = 0; d < dim; ++d)
       scale[d] = update == DomainUpdate::det_F ? iso :

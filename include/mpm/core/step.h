@@ -44,14 +44,16 @@ namespace mpm
   };
 
   // What the device's kernels compile (explicit_step's template argument). The affine
-  // transfers and Hencky's law cost every launch registers and time where compiled in (Hencky
-  // alone: 4% of P1's step on the H100, doc/log.md), so the device compiles them only into a
-  // second variant of the step, run where a run asks for them (DeviceEngine). Host code
-  // compiles everything either way.
+  // transfers, Hencky's law, Mohr-Coulomb and U's domains cost every launch registers and time
+  // where compiled in (Hencky alone: 4% of P1's step on the H100; Mohr-Coulomb and U with their
+  // eigen decompositions most of the kinematics' spills, doc/log.md), so the device compiles
+  // them only into a second variant of the step, run where a run asks for them
+  // (settings_ and materials_need_all_physics, DeviceEngine). Host code compiles everything either way.
   enum class DevicePhysics : int
   {
-    standard = 0, // the FLIP/PIC blend and the Jaumann rate form
-    all      = 1  // also the affine transfers (TPIC, APIC) and Hencky's law
+    standard = 0, // the FLIP/PIC blend, the Jaumann rate form, linear elasticity and Drucker-Prager,
+                  // GIMP's domains kept, scaled by det F or by F_ii
+    all = 1       // also the affine transfers (TPIC, APIC), Hencky's law, Mohr-Coulomb, U's domains
   };
 
   // Whether the code being compiled holds the affine transfers and Hencky's law: always on the
@@ -128,6 +130,23 @@ namespace mpm
     // argument. nullptr: the argument. Not converted between precisions (converted<>()).
     const Real *time_step_on_device = nullptr;
   };
+
+  // Whether a step with these settings, or these materials (any range of MaterialParameters),
+  // needs the device's DevicePhysics::all kernels.
+  template <int dim, typename Real>
+  bool settings_need_all_physics(const StepSettings<dim, Real> &s)
+  {
+    return s.affine_state_variable >= 0 || s.domain_update == DomainUpdate::U;
+  }
+
+  template <typename Materials>
+  bool materials_need_all_physics(const Materials &materials)
+  {
+    for (const auto &m : materials)
+      if (m.elastic_law == ElasticLaw::hencky || m.model == MaterialModel::mohr_coulomb)
+        return true;
+    return false;
+  }
 
   // The time step a step's kernels use: the argument, or the device's own (above).
   template <int dim, typename Real>
@@ -1060,7 +1079,7 @@ namespace mpm
           Real scale[dim], initial[dim]; // every load before the first store, as below
           for (int d = 0; d < dim; ++d)
             initial[d] = p.initial_domain_half_length[d][i];
-          gimp_domain_scale<dim>(s.domain_update, f, J, scale);
+          gimp_domain_scale<dim, all_physics_compiled<physics>()>(s.domain_update, f, J, scale);
           for (int d = 0; d < dim; ++d)
             {
               // GIMP weights are valid up to half a cell.
@@ -1354,9 +1373,10 @@ namespace mpm
   // One step of the chosen scheme. Returns the reductions needed for the next time
   // step and for the time history.
   // physics: which physics the device's kernels hold (DevicePhysics); the host's hold all. On the
-  // device a material with Hencky's law needs DevicePhysics::all: the standard kernels run the
-  // Jaumann rate form for it, and the material table lives on the device, so this cannot check it
-  // (DeviceEngine picks the variant from the host's table).
+  // device a material with Hencky's law or Mohr-Coulomb needs DevicePhysics::all: the standard
+  // kernels run the Jaumann rate form for the one and give the other a NaN stress, and the
+  // material table lives on the device, so this cannot check it (DeviceEngine picks the variant
+  // from the host's table, materials_need_all_physics).
   template <int dim, typename Shape, DevicePhysics physics = DevicePhysics::standard, typename Real, typename Backend,
             typename Exchange = NoGridExchange>
   StepReduction<Real> explicit_step(Backend &backend, const GridView<dim, Real> &g,
@@ -1382,6 +1402,9 @@ namespace mpm
           throw std::invalid_argument("explicit_step: the fused step runs without pressure averaging (the next "
                                       "P2G reads the averaged stresses), held points and affine transfers");
       }
+    if (atomic_scatter<Backend>::value && physics != DevicePhysics::all && s.domain_update == DomainUpdate::U)
+      throw std::invalid_argument("explicit_step: GIMP's domains by U need the device's kernels compiled with them "
+                                  "(explicit_step<dim, Shape, DevicePhysics::all>)");
     if (s.affine_state_variable >= 0)
       {
         if (atomic_scatter<Backend>::value && physics != DevicePhysics::all)

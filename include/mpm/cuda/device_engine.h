@@ -115,8 +115,9 @@ namespace mpm
 
       // One step on the device; only the reduction (max speed, power of gravity) comes back.
       // The affine transfers (settings.affine_state_variable: the uploaded points hold the
-      // matrices) and a material with Hencky's law run the step's second variant of kernels
-      // (DevicePhysics::all, step.h); everything else the standard one.
+      // matrices), GIMP's domains by U and a material with Hencky's law or Mohr-Coulomb run the
+      // step's second variant of kernels (DevicePhysics::all, step.h); everything else the
+      // standard one.
       StepReduction<double> step(const StepSettings<dim, double> &settings, double dt);
 
       // A step queued behind the last one without waiting for it: its time step is computed

@@ -11,6 +11,7 @@
 #include <mpm/core/material/mohr_coulomb.h>
 #include <mpm/core/material/user_model.h>
 
+#include <cmath>
 #include <type_traits>
 
 namespace mpm
@@ -95,15 +96,15 @@ namespace mpm
   }
 
   // The update of a point that knows its whole motion over the step (the MPM step): the
-  // material's elastic law picks the Jaumann rate form or Hencky's. with_hencky = false leaves
-  // Hencky's law out of the compiled code (the device's standard kernels, step.h's
-  // DevicePhysics): every material then runs the Jaumann rate form, and the caller must have
-  // made sure none asks for Hencky.
-  template <bool with_hencky = true, typename Real>
+  // material's elastic law picks the Jaumann rate form or Hencky's. all_laws = false leaves
+  // Hencky's law and Mohr-Coulomb out of the compiled code (the device's standard kernels,
+  // step.h's DevicePhysics): the caller must have made sure no material asks for either
+  // (materials_need_all_physics, step.h); one that does gets a NaN stress, which the step reports.
+  template <bool all_laws = true, typename Real>
   MPM_HOST_DEVICE inline void update_stress(const MaterialParameters<Real> &m, const StepKinematics<Real> &k,
                                             MaterialPointState<Real> &state);
 
-  template <typename Real>
+  template <bool all_laws = true, typename Real>
   MPM_HOST_DEVICE inline void update_stress(const MaterialParameters<Real> &m,
                                             const SymTensor<Real>          &d_eps,
                                             const Mat3<Real>               &d_spin,
@@ -117,8 +118,14 @@ namespace mpm
                                 state.plastic_strain);
           break;
         case MaterialModel::mohr_coulomb:
-          mohr_coulomb_update(m.elastic, m.mohr_coulomb, m.plasticity_enabled, d_eps, d_spin, state.stress,
-                              state.plastic_strain);
+          // Its eigen decomposition costs the standard kernels about 60 bytes of spills per
+          // point (doc/log.md, 2026-12-05); they leave it out.
+          if constexpr (all_laws)
+            mohr_coulomb_update(m.elastic, m.mohr_coulomb, m.plasticity_enabled, d_eps, d_spin, state.stress,
+                                state.plastic_strain);
+          else
+            for (int c = 0; c < n_voigt; ++c)
+              state.stress[c] = Real(NAN);
           break;
         case MaterialModel::user_defined:
 #ifndef __CUDA_ARCH__
@@ -147,7 +154,7 @@ namespace mpm
     return m.disconnection_volume_ratio > Real(0) && J > m.disconnection_volume_ratio;
   }
 
-  template <bool with_hencky, typename Real>
+  template <bool all_laws, typename Real>
   MPM_HOST_DEVICE inline void update_stress(const MaterialParameters<Real> &m, const StepKinematics<Real> &k,
                                             MaterialPointState<Real> &state)
   {
@@ -156,7 +163,7 @@ namespace mpm
         state.stress = SymTensor<Real>::zero();
         return;
       }
-    if constexpr (with_hencky)
+    if constexpr (all_laws)
       {
         if (m.elastic_law == ElasticLaw::hencky && m.model != MaterialModel::user_defined)
           {
@@ -185,6 +192,6 @@ namespace mpm
             return;
           }
       }
-    update_stress(m, k.d_eps, k.d_spin, state);
+    update_stress<all_laws>(m, k.d_eps, k.d_spin, state);
   }
 } // namespace mpm
