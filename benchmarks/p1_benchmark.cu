@@ -25,6 +25,9 @@
 //   --fused                 the fused step (step.h, FusedTransfer): each step's kinematics carries
 //                           the next step's P2G (the last timed step and the later sections run
 //                           unfused); the sanity columns show whether the physics stayed the same
+// p1_benchmark_scene_only (MPM_P1_SCENE_ONLY) holds P1's own step alone (3D GIMP, FP64 or FP32, the
+// standard kernels) and refuses the options that need others: a build of minutes instead of about 20 on the
+// 2-core machine, for trying a kernel change before building everything.
 //   --launch-modes N        after the timed run, N steps at a fixed time step three ways: the
 //                           reduction read back after every step (as the programs run), never
 //                           read back (the host runs ahead), and each step one CUDA graph
@@ -307,6 +310,9 @@ namespace
     auto sort_if_due = [&](const long step) {
       if (!(opt.sort_every > 0 && step % opt.sort_every == 0))
         return false;
+#if defined(MPM_P1_SCENE_ONLY)
+      order.template sort<GimpShape>(backend, gv, dpoints);
+#else
       if (opt.shape == ShapeFunction::linear || opt.shape == ShapeFunction::cpdi) // CPDI: by the point's cell
         order.template sort<LinearShape>(backend, gv, dpoints);
       else if (opt.shape == ShapeFunction::bspline3)
@@ -315,6 +321,7 @@ namespace
         order.template sort<CubicBSplineGimpShape>(backend, gv, dpoints);
       else // GIMP and the quadratic B-spline share the stencil's first node
         order.template sort<GimpShape>(backend, gv, dpoints);
+#endif
       pv = dpoints.view();
       return true;
     };
@@ -334,11 +341,16 @@ namespace
     FusedTransfer<3, Real> fused;
     auto step = [&](const double dt) {
       FusedTransfer<3, Real> *f = opt.fused ? &fused : nullptr;
+#if defined(MPM_P1_SCENE_ONLY)
+      return explicit_step<3, GimpShape>(backend, gv, pv, dmaterials.data(), s, Real(dt), NoGridExchange(), nullptr,
+                                         f);
+#else
       return opt.all_physics() ?
                explicit_step<3, DevicePhysics::all>(backend, opt.shape, gv, pv, dmaterials.data(), s, Real(dt),
                                                     NoGridExchange(), nullptr, f) :
                explicit_step<3>(backend, opt.shape, gv, pv, dmaterials.data(), s, Real(dt), NoGridExchange(),
                                 nullptr, f);
+#endif
     };
     // Whether the step at time t with time step dt carries the next one's P2G, and with which gravity.
     auto plan_fusion = [&](const double t, const double dt, const bool next_runs) {
@@ -625,6 +637,15 @@ int main(int argc, char **argv)
       std::printf("--fused: not with --transfer tpic|apic (the fused step runs the FLIP/PIC blend only)\n");
       return 2;
     }
+#if defined(MPM_P1_SCENE_ONLY)
+  if (opt.shape != ShapeFunction::gimp || opt.all_physics())
+    {
+      std::printf("%s: built for P1's own step only (3D GIMP, --domain detF|Fii|none, the FLIP/PIC blend, "
+                  "Jaumann); --shape, --domain U, --transfer and --law hencky need p1_benchmark\n",
+                  argv[0]);
+      return 2;
+    }
+#endif
   if (cuda_device_count() == 0)
     {
       std::printf("p1_benchmark: no CUDA device found\n");

@@ -43,13 +43,13 @@ namespace mpm
         f(i);
     }
 
-    // The gather loops (G2P kinematics with the constitutive update: 146 registers
-    // unbounded, 18% occupancy on P1) with a register cap from a minimum number of
-    // resident blocks of gather_block_size threads; 0: no cap. 5 blocks (102 registers,
-    // some spilling) took P1's kinematics from 6.27 to 4.80 ms per step at 12.8M points,
-    // 4 blocks to 5.23 ms (H100, doc/performance.md).
+    // The gather loops (G2P kinematics with the constitutive update) with a register cap
+    // from a minimum number of resident blocks of gather_block_size threads; 0: no cap.
+    // 4 blocks (128 registers): the standard kernels' FP64 kinematics without spills since
+    // Mohr-Coulomb and U's domains left them; P1's kinematics 3.67 -> 3.25 ms per step at
+    // 12.8M points against 5 blocks (H100, 2026-12-05, doc/performance.md).
 #if !defined(MPM_GATHER_MIN_BLOCKS)
-#  define MPM_GATHER_MIN_BLOCKS 5
+#  define MPM_GATHER_MIN_BLOCKS 4
 #endif
 #if MPM_GATHER_MIN_BLOCKS > 0
     constexpr int gather_block_size = 128;
