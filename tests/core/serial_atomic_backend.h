@@ -42,7 +42,7 @@ namespace mpm_test
         f(i);
     }
 
-    template <typename F>
+    template <typename Real = void, typename F> // Real: as CudaBackend's (its register cap)
     void gather_points(const int n, F &&f) const
     {
       for (int i = 0; i < n; ++i)

@@ -846,7 +846,7 @@ namespace mpm
     void grid_to_particle_velocity(Backend &backend, const GridView<dim, Real> &g,
                                    const PointsView<dim, Real> &p, const StepSettings<dim, Real> &s)
     {
-      backend.gather_points(p.n_points, [=] MPM_HOST_DEVICE(const int i) {
+      backend.template gather_points<Real>(p.n_points, [=] MPM_HOST_DEVICE(const int i) {
         if (p.material[i] < 0)
           return;
         Real x[dim], lp[domain_values<dim, Shape>()], v_new[dim];
@@ -1038,7 +1038,7 @@ namespace mpm
       for (int d = 0; d < dim; ++d)
         next_gravity.g[d] = next_gravity_given != nullptr ? next_gravity_given[d] : Real(0);
       const MaterialParameters<Real> *disconnecting = disconnecting_materials(s, materials);
-      backend.gather_points(p.n_points, [=] MPM_HOST_DEVICE(const int i) {
+      backend.template gather_points<Real>(p.n_points, [=] MPM_HOST_DEVICE(const int i) {
         if (p.material[i] < 0)
           return;
         const Real dt = time_step_of(s, dt_given);
@@ -1310,7 +1310,7 @@ namespace mpm
     void finish_pressure_averaging(Backend &backend, const GridView<dim, Real> &g, const PointsView<dim, Real> &p,
                                    const MaterialParameters<Real> *disconnecting = nullptr)
     {
-      backend.gather_points(p.n_points, [=] MPM_HOST_DEVICE(const int i) {
+      backend.template gather_points<Real>(p.n_points, [=] MPM_HOST_DEVICE(const int i) {
         if (p.material[i] >= 0)
           apply_cell_pressure(g, p, i, disconnecting);
       });

@@ -88,7 +88,7 @@ namespace mpm
       parallel(n, f);
     }
 
-    template <typename F>
+    template <typename Real = void, typename F> // Real: as CudaBackend's (its register cap)
     void gather_points(const int n, F &&f) const
     {
       parallel(n, f);

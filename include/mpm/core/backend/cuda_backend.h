@@ -44,17 +44,29 @@ namespace mpm
     }
 
     // The gather loops (G2P kinematics with the constitutive update) with a register cap
-    // from a minimum number of resident blocks of gather_block_size threads; 0: no cap.
-    // 4 blocks (128 registers): the standard kernels' FP64 kinematics without spills since
-    // Mohr-Coulomb and U's domains left them; P1's kinematics 3.67 -> 3.25 ms per step at
-    // 12.8M points against 5 blocks (H100, 2026-12-05, doc/performance.md).
-#if !defined(MPM_GATHER_MIN_BLOCKS)
-#  define MPM_GATHER_MIN_BLOCKS 4
+    // from a minimum number of resident blocks of gather_block_size threads, per precision;
+    // MPM_GATHER_MIN_BLOCKS sets both (0: no cap). FP64 4 blocks (128 registers): the
+    // standard kernels' kinematics spills nothing since Mohr-Coulomb and U's domains left
+    // them, and P1's took 3.25 ms per step at 12.8M points against 3.67 ms with 5 blocks;
+    // FP32 5 blocks (96 registers, no spills): 1.80 ms against 1.90 ms with 4 (H100,
+    // 2026-12-05, doc/performance.md).
+#if defined(MPM_GATHER_MIN_BLOCKS)
+#  define MPM_GATHER_MIN_BLOCKS_FP64 MPM_GATHER_MIN_BLOCKS
+#  define MPM_GATHER_MIN_BLOCKS_FP32 MPM_GATHER_MIN_BLOCKS
+#else
+#  define MPM_GATHER_MIN_BLOCKS_FP64 4
+#  define MPM_GATHER_MIN_BLOCKS_FP32 5
 #endif
-#if MPM_GATHER_MIN_BLOCKS > 0
+#if MPM_GATHER_MIN_BLOCKS_FP64 > 0
     constexpr int gather_block_size = 128;
-    template <typename F>
-    __global__ void __launch_bounds__(gather_block_size, MPM_GATHER_MIN_BLOCKS) gather_kernel_bounded(const int n, F f)
+    // Real: the precision of the points the loop reads (void: FP64's cap).
+    template <typename Real>
+    constexpr int gather_min_blocks()
+    {
+      return std::is_same_v<Real, float> ? MPM_GATHER_MIN_BLOCKS_FP32 : MPM_GATHER_MIN_BLOCKS_FP64;
+    }
+    template <int min_blocks, typename F>
+    __global__ void __launch_bounds__(gather_block_size, min_blocks) gather_kernel_bounded(const int n, F f)
     {
       const int i = static_cast<int>(blockIdx.x) * static_cast<int>(blockDim.x) + static_cast<int>(threadIdx.x);
       if (i < n)
@@ -490,16 +502,18 @@ namespace mpm
       launch(n, std::forward<F>(f));
     }
 
-    template <typename F>
+    // Real: the precision of the points (the register cap's, above); void: FP64's.
+    template <typename Real = void, typename F>
     void gather_points(const int n, F &&f)
     {
-#if MPM_GATHER_MIN_BLOCKS > 0
+#if MPM_GATHER_MIN_BLOCKS_FP64 > 0
       if (n <= 0)
         return;
       using FT = typename std::decay<F>::type;
       constexpr int threads = cuda_detail::gather_block_size;
       begin_timing();
-      cuda_detail::gather_kernel_bounded<FT><<<(n + threads - 1) / threads, threads, 0, stream>>>(n, f);
+      cuda_detail::gather_kernel_bounded<cuda_detail::gather_min_blocks<Real>(), FT>
+        <<<(n + threads - 1) / threads, threads, 0, stream>>>(n, f);
       MPM_CUDA_CHECK_LAUNCH();
       end_timing();
 #else
