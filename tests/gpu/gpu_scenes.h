@@ -33,7 +33,8 @@ namespace mpm_test
 
   // n_steps of a scene at the adaptive time step cfl h / (c + largest speed); held scenes
   // (s.hold_points) take their first step from the points' momentum, as the equilibration does.
-  // all_physics: the device's kernels that hold Hencky's law and the affine transfers.
+  // all_physics: the device's kernels that hold Hencky's law, Mohr-Coulomb, U's domains and the
+  // affine transfers (step.h's DevicePhysics).
   template <int dim, typename SceneTarget>
   SceneResult step_scene(SceneTarget &target, mpm::StepSettings<dim, double> &s, const double cfl, const double h,
                          const double c, const long n_steps, const bool all_physics = false)
@@ -110,12 +111,13 @@ namespace mpm_test
   // V3's prm (the flow carries centres through this floor where the wall does not stop them,
   // tests/core/test_wall_friction).
   // disconnection_volume_ratio: the material's (material.h, disconnected points).
+  // mohr_coulomb (with drucker_prager): Mohr-Coulomb with the same strength instead.
   template <template <int, typename> class Target>
   SceneResult collapse(mpm::HostPoints<2, double> &points, const long n_steps,
                        const mpm::HostPoints<2, double> *initial = nullptr, const bool drucker_prager = false,
                        const bool held = false, const mpm::ElasticLaw law = mpm::ElasticLaw::jaumann_rate,
                        const bool floor_at_face = false, const bool flip_fixed_velocity_change = false,
-                       const double disconnection_volume_ratio = 0)
+                       const double disconnection_volume_ratio = 0, const bool mohr_coulomb = false)
   {
     using namespace mpm;
     const double h = 0.005, rho = 2650, E = 0.84e6, nu = 0.3, g = 9.81;
@@ -159,6 +161,11 @@ namespace mpm_test
         m.model                                   = MaterialModel::drucker_prager;
         m.drucker_prager.strength.friction_angle  = 19.8 * 3.14159265358979323846 / 180;
         m.drucker_prager.strength.residual_friction_angle = m.drucker_prager.strength.friction_angle;
+        if (mohr_coulomb)
+          {
+            m.model                 = MaterialModel::mohr_coulomb;
+            m.mohr_coulomb.strength = m.drucker_prager.strength;
+          }
       }
     m.elastic_law                = law;
     m.disconnection_volume_ratio = disconnection_volume_ratio;
@@ -188,7 +195,10 @@ namespace mpm_test
         s.wall_faces         = 1u << 2;
       }
     Target<2, double> target(grid, points, {m});
-    return step_scene<2>(target, s, cfl, h, c, n_steps, law == ElasticLaw::hencky);
+    // The kernels a DeviceEngine would pick for this material and these settings.
+    const bool all_physics = materials_need_all_physics(std::vector<MaterialParameters<double>>{m}) ||
+                             settings_need_all_physics(s);
+    return step_scene<2>(target, s, cfl, h, c, n_steps, all_physics);
   }
 
   // The slide: frictional walls (wall_friction.h) on the base and on the wall it runs into.
