@@ -56,8 +56,9 @@ namespace mpm
     all = 1       // also the affine transfers (TPIC, APIC), Hencky's law, Mohr-Coulomb, U's domains
   };
 
-  // Whether the code being compiled holds the affine transfers and Hencky's law: always on the
-  // host, on the device where the step's variant asks for them.
+  // Whether the code being compiled holds DevicePhysics::all's physics (the affine transfers,
+  // Hencky, Mohr-Coulomb, U's domains): always on the host, on the device where the step's
+  // variant asks for them.
   template <DevicePhysics physics>
   MPM_HOST_DEVICE constexpr bool all_physics_compiled()
   {
