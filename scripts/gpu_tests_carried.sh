@@ -2,7 +2,8 @@
 # GPU test programs built on the development VM, run on the GPU machine: each DIR/NAME.xz (or NAME)
 # is unpacked and run; then compute-sanitizer's memcheck and racecheck on those named in SANITIZE
 # (default: test_gpu_transfer_conservation). The device's own build of the tests does not fit its
-# calls (doc/log.md, 2026-12-05).
+# calls (doc/log.md, 2026-12-05). TESTS: the names to run, in order (default every test_gpu_* of DIR);
+# TEST_LIMIT: seconds per test (default 300), SANITIZE_LIMIT per sanitizer run (default 240).
 #   gpu_tests_carried.sh DIR OUTDIR
 set -u -o pipefail
 dir=$(readlink -f "$1") out=$2
@@ -12,11 +13,17 @@ unxz_beside "$dir"
 chmod +x "$dir"/test_gpu_*
 { nvidia-smi --query-gpu=name,driver_version --format=csv,noheader; date -u; } | tee "$out/machine.txt"
 status=0
-for t in "$dir"/test_gpu_*; do
+if [ -n "${TESTS:-}" ]; then
+  programs=()
+  for n in $TESTS; do programs+=("$dir/$n"); done
+else
+  programs=("$dir"/test_gpu_*)
+fi
+for t in "${programs[@]}"; do
   case $t in *.xz) continue ;; esac
   name=$(basename "$t")
   start=$(date +%s)
-  timeout 300 "$t" >"$out/$name.log" 2>&1
+  timeout "${TEST_LIMIT:-300}" "$t" >"$out/$name.log" 2>&1
   rc=$?
   [ $rc = 0 ] || status=1
   echo "== $name: rc $rc ($(($(date +%s) - start)) s)"
@@ -26,7 +33,7 @@ CS=$(ls -d /usr/local/cuda*/bin 2>/dev/null | head -1)/compute-sanitizer
 for name in ${SANITIZE:-test_gpu_transfer_conservation}; do
   [ -x "$CS" ] && [ -x "$dir/$name" ] || continue
   for tool in memcheck racecheck; do
-    timeout 240 "$CS" --tool $tool "$dir/$name" >"$out/$name.$tool.log" 2>&1 || status=1
+    timeout "${SANITIZE_LIMIT:-240}" "$CS" --tool $tool "$dir/$name" >"$out/$name.$tool.log" 2>&1 || status=1
     echo "== $name under $tool: $(grep -E 'ERROR SUMMARY|RACECHECK SUMMARY' "$out/$name.$tool.log" | tr '\n' ' ')"
   done
 done
