@@ -3,7 +3,9 @@
 // so a run that asks for any of them must get the `all` kernels, and a standard step on an
 // atomic backend (the device's paths) refuses U's domains instead of running uGIMP's.
 // On the host both variants hold everything: the same step with the `all` variant on the
-// serial atomic backend gives the CPU backend's domains.
+// serial atomic backend gives the CPU backend's domains. What the device's standard kernels leave
+// out cannot be seen here (host code compiles it all); test_gpu_affine_hencky runs Mohr-Coulomb
+// and U's domains on the GPU through the variant these functions pick.
 #include "check.h"
 #include "serial_atomic_backend.h"
 

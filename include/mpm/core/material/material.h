@@ -118,8 +118,9 @@ namespace mpm
                                 state.plastic_strain);
           break;
         case MaterialModel::mohr_coulomb:
-          // Its eigen decomposition costs the standard kernels about 60 bytes of spills per
-          // point (doc/log.md, 2026-12-05); they leave it out.
+          // Its eigen decomposition (with U's domains) made the standard FP64 kinematics spill:
+          // 614 / 1,024 bytes of spill stores / loads at 96 registers against 142 / 272 without
+          // them (nvcc, 2026-12-05, doc/performance.md); they leave it out.
           if constexpr (all_laws)
             mohr_coulomb_update(m.elastic, m.mohr_coulomb, m.plasticity_enabled, d_eps, d_spin, state.stress,
                                 state.plastic_strain);
