@@ -16,7 +16,8 @@
 //             cell (sorted by cell index, x fastest: what sorting by cell would give),
 //             random (shuffled: the worst case for the atomic scatter)
 //   --block N threads per block of the point and node loops (default 128)
-//   --material elastic|dp   linear elastic stand-in, or ep2-3De's Drucker-Prager (default dp)
+//   --material elastic|dp|mc   linear elastic stand-in, ep2-3De's Drucker-Prager (default dp), or
+//                           Mohr-Coulomb with the same strengths (runs the DevicePhysics::all kernels)
 //   --sort-every N          sort the points by stencil on the device every N steps (0: never;
 //                           default 20), so that the warp adders reduce runs of shared nodes
 //   --shape gimp|linear|bspline2|bspline3|bspline3gimp|cpdi   the shape function (default gimp;
@@ -62,6 +63,7 @@ namespace
     std::string      order = "generated";
     int              block = 128;
     bool             drucker_prager = true;
+    bool             mohr_coulomb   = false; // with drucker_prager: Mohr-Coulomb in its place
     int              sort_every     = 20;
     ShapeFunction    shape          = ShapeFunction::gimp;
     DomainUpdate     domain         = DomainUpdate::det_F; // GIMP's; P1's own is det F
@@ -70,7 +72,7 @@ namespace
     bool             affine   = false;
     AffineMatrix     affine_matrix = AffineMatrix::velocity_gradient;
     bool             hencky   = false;
-    bool             all_physics() const { return affine || hencky || domain == DomainUpdate::U; }
+    bool all_physics() const { return affine || hencky || mohr_coulomb || domain == DomainUpdate::U; }
     long             launch_mode_steps = 0;
     bool             fused             = false;
   };
@@ -277,7 +279,7 @@ namespace
     HostGrid<3, Real>   grid;
     HostPoints<3, Real> points;
     std::vector<MaterialParameters<Real>> materials;
-    mpm_bench::make_p1(n_cells_y, grid, points, materials, opt.drucker_prager);
+    mpm_bench::make_p1(n_cells_y, grid, points, materials, opt.drucker_prager, opt.mohr_coulomb);
     reorder(points, grid, opt.order);
     if (opt.affine) // the affine matrices, zero at the start
       points.set_n_state_variables(3 * 3);
@@ -431,7 +433,7 @@ namespace
       label += ", " + opt.order + " order";
     if (opt.block != 128)
       label += ", block " + std::to_string(opt.block);
-    label += opt.drucker_prager ? ", DP" : ", elastic";
+    label += opt.mohr_coulomb ? ", MC" : opt.drucker_prager ? ", DP" : ", elastic";
     label += opt.shape == ShapeFunction::linear   ? ", linear" :
              opt.shape == ShapeFunction::bspline2 ? ", B-spline" :
              opt.shape == ShapeFunction::bspline3 ? ", cubic B-spline" :
@@ -537,12 +539,13 @@ int main(int argc, char **argv)
       else if (a == "--material" && i + 1 < argc)
         {
           const std::string m = argv[++i];
-          if (m != "dp" && m != "elastic")
+          if (m != "dp" && m != "mc" && m != "elastic")
             {
-              std::printf("--material: expected dp or elastic, got %s\n", m.c_str());
+              std::printf("--material: expected dp, mc or elastic, got %s\n", m.c_str());
               return 2;
             }
-          opt.drucker_prager = m == "dp";
+          opt.drucker_prager = m != "elastic";
+          opt.mohr_coulomb   = m == "mc";
         }
       else if (a == "--sort-every" && i + 1 < argc)
         opt.sort_every = std::atoi(argv[++i]);
@@ -617,7 +620,7 @@ int main(int argc, char **argv)
       else
         {
           std::printf("usage: %s [--fp32] [--sizes 20,160,640,2560] [--steps N] [--profile] [--table FILE]\n"
-                      "          [--order generated|cell|random] [--block N] [--material dp|elastic] [--sort-every N]\n"
+                      "          [--order generated|cell|random] [--block N] [--material dp|mc|elastic] [--sort-every N]\n"
                       "          [--shape gimp|linear|bspline2|bspline3|bspline3gimp|cpdi] [--domain detF|Fii|U|none]\n"
                       "          [--transfer tpic|apic] [--law jaumann|hencky] [--fused] [--launch-modes N]\n",
                       argv[0]);
@@ -641,7 +644,8 @@ int main(int argc, char **argv)
   if (opt.shape != ShapeFunction::gimp || opt.all_physics())
     {
       std::printf("%s: built for P1's own step only (3D GIMP, --domain detF|Fii|none, the FLIP/PIC blend, "
-                  "Jaumann); --shape, --domain U, --transfer and --law hencky need p1_benchmark\n",
+                  "Jaumann, no Mohr-Coulomb); --shape, --domain U, --transfer, --law hencky and --material mc need "
+                  "p1_benchmark\n",
                   argv[0]);
       return 2;
     }
@@ -665,7 +669,9 @@ int main(int argc, char **argv)
       const double per_point = opt.fp32 ? DevicePoints<3, float>::bytes_per_point() : DevicePoints<3, double>::bytes_per_point();
       std::printf("scene P1 (elastic phase, %s), %s, point order %s, sorted every %d steps, %d threads per block; "
                   "device memory per point %.0f B: about %.0f M points would fit\n",
-                  opt.drucker_prager ? "Drucker-Prager" : "linear elastic stand-in for Drucker-Prager",
+                  opt.mohr_coulomb   ? "Mohr-Coulomb with Drucker-Prager's strengths" :
+                  opt.drucker_prager ? "Drucker-Prager" :
+                                       "linear elastic stand-in for Drucker-Prager",
                   opt.fp32 ? "FP32" : "FP64", opt.order.c_str(), opt.sort_every, opt.block, per_point,
                   0.9 * free_bytes / (per_point * 1.1) / 1e6);
       std::printf("| prec | points | cells | nodes | steps | wall s | point-updates/s | ms/step | min bytes/step | "

@@ -11,7 +11,8 @@
 // Material: rho = 2700, E = 1 MPa, nu = 0.3; either linear elastic (Jaumann) or, as
 // ep2-3De runs it, Drucker-Prager with plasticity on from the start: c = 20 kPa (c_res =
 // 4 kPa, softening modulus 60 kPa x h), phi = 20 deg (7 deg in the weak layer z < 3.84 m,
-// material 1), psi = 0, tension cut-off at the apex. Gravity ramped linearly over 8/1.5 s,
+// material 1), psi = 0, tension cut-off at the apex; or Mohr-Coulomb with the same strengths
+// (for timing the kernels that hold it). Gravity ramped linearly over 8/1.5 s,
 // local damping 0.1, CFL 0.5, 8 s.
 #pragma once
 
@@ -73,7 +74,8 @@ namespace mpm_bench
   // 100,240 / 801,920 / 3,207,680 / 12,830,720 points.
   template <typename Real>
   void make_p1(const int n_cells_y, mpm::HostGrid<3, Real> &grid, mpm::HostPoints<3, Real> &points,
-               std::vector<mpm::MaterialParameters<Real>> &materials, const bool drucker_prager = false)
+               std::vector<mpm::MaterialParameters<Real>> &materials, const bool drucker_prager = false,
+               const bool mohr_coulomb = false)
   {
     using namespace mpm;
     const double h        = P1::h;
@@ -141,6 +143,12 @@ namespace mpm_bench
         materials.assign(2, m);
         materials[1].drucker_prager.strength.friction_angle          = Real(7 * degree);
         materials[1].drucker_prager.strength.residual_friction_angle = Real(7 * degree);
+        if (mohr_coulomb)
+          for (MaterialParameters<Real> &weak_or_not : materials)
+            {
+              weak_or_not.model                 = MaterialModel::mohr_coulomb;
+              weak_or_not.mohr_coulomb.strength = weak_or_not.drucker_prager.strength;
+            }
       }
   }
 
