@@ -8,6 +8,9 @@
 set -u -o pipefail
 dir=$(readlink -f "$1") out=$2
 mkdir -p "$out"
+# Programs that link TBB through the core (test_gpu_affine_hencky) find it only in the deal.II runtime
+# (../shared/device-dealii); the GPU host has none of its own.
+[ -f /opt/dl/dl-env.sh ] && . /opt/dl/dl-env.sh
 . "$(dirname "$0")/gpu_unpack_build.sh"
 unxz_beside "$dir"
 chmod +x "$dir"/test_gpu_*
