@@ -44,9 +44,16 @@ if command -v compute-sanitizer >/dev/null; then
   # the device engine (dealii-mpm's Backend = cuda) with pressure averaging: its scatter in
   # the kinematics and its gather deferred to the next P2G
   compute-sanitizer --tool memcheck "$BUILD/tests/gpu/test_gpu_device_engine" >"$OUT/memcheck_engine.log" 2>&1 || status=1
+  # the other scatters (2D, linear; MUSL, USL, USF) in the short form racecheck finishes (30 s
+  # on an H100; the whole test does not end in minutes), and the device engine (190 s)
+  compute-sanitizer --tool racecheck "$BUILD/tests/gpu/test_gpu_transfer_conservation" --short \
+    >"$OUT/racecheck_transfer.log" 2>&1 || status=1
+  compute-sanitizer --tool racecheck "$BUILD/tests/gpu/test_gpu_device_engine" >"$OUT/racecheck_engine.log" 2>&1 || status=1
   echo "memcheck:  $(grep -E 'ERROR SUMMARY|LEAK SUMMARY' "$OUT/memcheck.log" | tr '\n' ' ')"
   echo "memcheck (device engine): $(grep -E 'ERROR SUMMARY' "$OUT/memcheck_engine.log" | tr '\n' ' ')"
   echo "racecheck: $(grep -E 'RACECHECK SUMMARY|ERROR SUMMARY' "$OUT/racecheck.log" | tr '\n' ' ')"
+  echo "racecheck (transfers, short): $(grep -E 'RACECHECK SUMMARY|ERROR SUMMARY' "$OUT/racecheck_transfer.log" | tr '\n' ' ')"
+  echo "racecheck (device engine): $(grep -E 'RACECHECK SUMMARY|ERROR SUMMARY' "$OUT/racecheck_engine.log" | tr '\n' ' ')"
 else
   echo "compute-sanitizer: not found"
 fi

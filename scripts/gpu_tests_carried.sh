@@ -1,9 +1,11 @@
 #!/bin/bash
 # GPU test programs built on the development VM, run on the GPU machine: each DIR/NAME.xz (or NAME)
-# is unpacked and run; then compute-sanitizer's memcheck and racecheck on those named in SANITIZE
-# (default: test_gpu_transfer_conservation). The device's own build of the tests does not fit its
-# calls (doc/log.md, 2026-12-05). TESTS: the names to run, in order (default every test_gpu_* of DIR);
-# TEST_LIMIT: seconds per test (default 300), SANITIZE_LIMIT per sanitizer run (default 240).
+# is unpacked and run; then compute-sanitizer's tools (SANITIZE_TOOLS, default "memcheck racecheck")
+# on those named in SANITIZE (default: test_gpu_transfer_conservation), each NAME or NAME:ARGUMENT
+# (test_gpu_transfer_conservation:--short, the form racecheck finishes). The device's own build of
+# the tests does not fit its calls (doc/log.md, 2026-12-05). TESTS: the names to run, in order
+# (default every test_gpu_* of DIR); TEST_LIMIT: seconds per test (default 300), SANITIZE_LIMIT per
+# sanitizer run (default 240).
 #   gpu_tests_carried.sh DIR OUTDIR
 set -u -o pipefail
 dir=$(readlink -f "$1") out=$2
@@ -33,11 +35,16 @@ for t in "${programs[@]}"; do
   tail -n 4 "$out/$name.log"
 done
 CS=$(ls -d /usr/local/cuda*/bin 2>/dev/null | head -1)/compute-sanitizer
-for name in ${SANITIZE:-test_gpu_transfer_conservation}; do
+for entry in ${SANITIZE:-test_gpu_transfer_conservation}; do
+  name=${entry%%:*} args=()
+  [ "$entry" = "$name" ] || args=("${entry#*:}")
   [ -x "$CS" ] && [ -x "$dir/$name" ] || continue
-  for tool in memcheck racecheck; do
-    timeout "${SANITIZE_LIMIT:-240}" "$CS" --tool $tool "$dir/$name" >"$out/$name.$tool.log" 2>&1 || status=1
-    echo "== $name under $tool: $(grep -E 'ERROR SUMMARY|RACECHECK SUMMARY' "$out/$name.$tool.log" | tr '\n' ' ')"
+  for tool in ${SANITIZE_TOOLS:-memcheck racecheck}; do
+    log="$out/$name.$tool.log"
+    start=$(date +%s)
+    # Line-buffered output: a run cut by the limit still shows how far it came.
+    timeout "${SANITIZE_LIMIT:-240}" stdbuf -oL "$CS" --tool $tool "$dir/$name" "${args[@]}" >"$log" 2>&1 || status=1
+    echo "== $name ${args[*]} under $tool ($(($(date +%s) - start)) s): $(grep -E 'ERROR SUMMARY|RACECHECK SUMMARY|all checks passed' "$log" | tr '\n' ' ')"
   done
 done
 exit $status
