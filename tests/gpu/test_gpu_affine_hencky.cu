@@ -3,13 +3,15 @@
 // device runs only where a run asks for them. Tolerances as in test_gpu_cpu_agreement.cu (its header says why):
 // undamped elastic scenes 1e-10, Drucker-Prager and damped ones max(1e-10, 100x the CPU's own
 // spread when its points are reordered). The affine matrices C_p are compared too, relative to
-// the largest |C| of the CPU run.
+// the largest |C| of the CPU run. --short: the spinning blocks alone (the affine transfers'
+// scatters), 30 steps each, for compute-sanitizer's racecheck (scripts/gpu_tests_carried.sh).
 #include "../core/check.h"
 #include "../core/spinning_block.h"
 #include "gpu_agreement.h"
 #include "gpu_scenes.h"
 
 #include <cmath>
+#include <cstring>
 #include <string>
 
 using namespace mpm;
@@ -32,11 +34,12 @@ double affine_difference(const HostPoints<dim, double> &ref, const HostPoints<di
   return diff / (scale > 0 ? scale : 1);
 }
 
-// The spinning block (tests/core/spinning_block.h), 300 steps, with an affine transfer.
+// The spinning block (tests/core/spinning_block.h), 300 steps (30 with --short), with an affine transfer.
+static long spin_steps = 300;
 template <int dim, typename Shape>
 void spin_agreement(const char *method, const DomainUpdate update, const Transfer transfer)
 {
-  const long              n = 300;
+  const long              n = spin_steps;
   HostPoints<dim, double> cpu, gpu, initial;
   spinning_block<dim, Shape, CpuTarget>(update, initial, M_PI / 2, 0, nullptr, transfer);
   const SpinResult on_cpu = spinning_block<dim, Shape, CpuTarget>(update, cpu, M_PI / 2, n, &initial, transfer);
@@ -58,10 +61,18 @@ void spin_agreement(const char *method, const DomainUpdate update, const Transfe
     }
 }
 
-int main()
+int main(int argc, char **argv)
 {
   if (!cuda_device_present("test_gpu_affine_hencky"))
     return skip_code;
+  const bool short_form = argc == 2 && std::strcmp(argv[1], "--short") == 0;
+  if (argc > 1 && !short_form)
+    {
+      std::printf("usage: test_gpu_affine_hencky [--short]\n");
+      return 2;
+    }
+  spin_steps = short_form ? 30 : 300;
+  std::setvbuf(stdout, nullptr, _IOLBF, 0); // a sanitizer's log shows how far it came
   try
     {
       const AffineMatrix tpic = AffineMatrix::velocity_gradient, apic = AffineMatrix::b_d_inverse;
@@ -74,6 +85,8 @@ int main()
       // 3D: cpGIMP U with TPIC; the cubic B-spline's 64 nodes with APIC.
       spin_agreement<3, GimpShape>("TPIC cpGIMP U", DomainUpdate::U, {0, true, tpic});
       spin_agreement<3, CubicBSplineShape>("APIC cubic B-spline", DomainUpdate::none, {0, true, apic});
+      if (short_form)
+        return finish("test_gpu_affine_hencky --short");
       {
         // V3 with Drucker-Prager and Hencky's law (2D: the closed-form principal stretches)
         const long            n      = 600;

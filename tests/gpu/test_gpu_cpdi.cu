@@ -5,17 +5,22 @@
 // its gradients too, so round-off stays round-off. Scenes: the V1 column at 32 cells, 1000
 // steps (damped: the CPU's reordering spread sets the bound), and the spinning block (its
 // domains rotate with F, undamped), 2D and 3D, with the FLIP blend and with TPIC; CPDI2q in 2D,
-// its corners (state variables) compared too.
+// its corners (state variables) compared too. --short: a tenth of the steps (100 and 30), the same
+// comparisons, for compute-sanitizer's racecheck (scripts/gpu_tests_carried.sh).
 #include "../core/check.h"
 #include "../core/spinning_block.h"
 #include "gpu_agreement.h"
 #include "gpu_scenes.h"
 
 #include <cmath>
+#include <cstring>
 #include <string>
 
 using namespace mpm;
 using namespace mpm_test;
+
+// --short: each scene's steps over this.
+static long step_divisor = 1;
 
 // Largest difference of CPDI2q's corner offsets (state variables) between two runs, over the cell size.
 double corner_difference(const HostPoints<2, double> &ref, const HostPoints<2, double> &other, const int first,
@@ -33,7 +38,7 @@ double corner_difference(const HostPoints<2, double> &ref, const HostPoints<2, d
 template <typename Shape>
 void column_agreement(const char *name)
 {
-  const long            n = 1000;
+  const long            n = 1000 / step_divisor;
   HostPoints<2, double> cpu, gpu, initial;
   ColumnSetup           setup{32, 0.5, DomainUpdate::none};
   setup.max_steps = 0;
@@ -59,7 +64,7 @@ void column_agreement(const char *name)
 template <int dim, typename Shape>
 void spin_agreement(const char *method, const Transfer transfer)
 {
-  const long              n = 300;
+  const long              n = 300 / step_divisor;
   HostPoints<dim, double> cpu, gpu, initial;
   spinning_block<dim, Shape, CpuTarget>(DomainUpdate::none, initial, M_PI / 2, 0, nullptr, transfer);
   const SpinResult on_cpu =
@@ -78,10 +83,18 @@ void spin_agreement(const char *method, const Transfer transfer)
     }
 }
 
-int main()
+int main(int argc, char **argv)
 {
   if (!cuda_device_present("test_gpu_cpdi"))
     return skip_code;
+  const bool short_form = argc == 2 && std::strcmp(argv[1], "--short") == 0;
+  if (argc > 1 && !short_form)
+    {
+      std::printf("usage: test_gpu_cpdi [--short]\n");
+      return 2;
+    }
+  step_divisor = short_form ? 10 : 1;
+  std::setvbuf(stdout, nullptr, _IOLBF, 0); // a sanitizer's log shows how far it came
   try
     {
       const Transfer tpic{0, true, AffineMatrix::velocity_gradient};
