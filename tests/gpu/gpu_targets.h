@@ -14,6 +14,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <random>
 #include <vector>
 
@@ -35,6 +36,20 @@ namespace mpm_test
     std::printf("%s: device %s (sm_%d%d, %d SMs)\n", test_name, prop.name, prop.major, prop.minor,
                 prop.multiProcessorCount);
     return true;
+  }
+
+  // The option some GPU tests take, --short (a tenth of the steps or fewer, for compute-sanitizer's
+  // racecheck, which does not finish them whole in minutes): true if given. Anything else gets a
+  // usage line and the exit code 2 in *exit_code (else 0). Output from then on is line-buffered, so
+  // that a sanitizer's log cut by a time limit shows how far the test came.
+  inline bool short_form_option(const int argc, char **argv, const char *test_name, int *exit_code)
+  {
+    const bool given = argc == 2 && std::strcmp(argv[1], "--short") == 0;
+    *exit_code       = argc > 1 && !given ? 2 : 0;
+    if (*exit_code != 0)
+      std::printf("usage: %s [--short]\n", test_name);
+    std::setvbuf(stdout, nullptr, _IOLBF, 0);
+    return given;
   }
 
   template <int dim, typename Real>

@@ -13,7 +13,6 @@
 #include "gpu_scenes.h"
 
 #include <cmath>
-#include <cstring>
 #include <string>
 
 using namespace mpm;
@@ -87,14 +86,11 @@ int main(int argc, char **argv)
 {
   if (!cuda_device_present("test_gpu_cpdi"))
     return skip_code;
-  const bool short_form = argc == 2 && std::strcmp(argv[1], "--short") == 0;
-  if (argc > 1 && !short_form)
-    {
-      std::printf("usage: test_gpu_cpdi [--short]\n");
-      return 2;
-    }
+  int        usage_error = 0;
+  const bool short_form  = short_form_option(argc, argv, "test_gpu_cpdi", &usage_error);
+  if (usage_error != 0)
+    return usage_error;
   step_divisor = short_form ? 10 : 1;
-  std::setvbuf(stdout, nullptr, _IOLBF, 0); // a sanitizer's log shows how far it came
   try
     {
       const Transfer tpic{0, true, AffineMatrix::velocity_gradient};

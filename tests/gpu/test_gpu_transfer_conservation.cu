@@ -5,19 +5,14 @@
 #include "../core/transfer_conservation_checks.h"
 #include "gpu_targets.h"
 
-#include <cstring>
-
 int main(int argc, char **argv)
 {
   if (!mpm_test::cuda_device_present("test_gpu_transfer_conservation"))
     return mpm_test::skip_code;
-  const bool short_form = argc > 1 && std::strcmp(argv[1], "--short") == 0;
-  if (argc > 2 || (argc == 2 && !short_form))
-    {
-      std::printf("usage: test_gpu_transfer_conservation [--short]\n");
-      return 2;
-    }
-  std::setvbuf(stdout, nullptr, _IOLBF, 0); // a sanitizer's log shows how far it came
+  int        usage_error = 0;
+  const bool short_form  = mpm_test::short_form_option(argc, argv, "test_gpu_transfer_conservation", &usage_error);
+  if (usage_error != 0)
+    return usage_error;
   try
     {
       mpm_test::check_transfer_conservation<mpm_test::CudaTarget>(short_form);
