@@ -47,7 +47,7 @@ namespace mpm_test
     const bool given = argc == 2 && std::strcmp(argv[1], "--short") == 0;
     *exit_code       = argc > 1 && !given ? 2 : 0;
     if (*exit_code != 0)
-      std::printf("usage: %s [--short]\n", test_name);
+      std::fprintf(stderr, "usage: %s [--short]\n", test_name);
     std::setvbuf(stdout, nullptr, _IOLBF, 0);
     return given;
   }

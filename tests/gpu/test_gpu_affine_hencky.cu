@@ -62,12 +62,12 @@ void spin_agreement(const char *method, const DomainUpdate update, const Transfe
 
 int main(int argc, char **argv)
 {
-  if (!cuda_device_present("test_gpu_affine_hencky"))
-    return skip_code;
   int        usage_error = 0;
   const bool short_form  = short_form_option(argc, argv, "test_gpu_affine_hencky", &usage_error);
   if (usage_error != 0)
     return usage_error;
+  if (!cuda_device_present("test_gpu_affine_hencky"))
+    return skip_code;
   spin_steps = short_form ? 30 : 300;
   try
     {

@@ -84,12 +84,12 @@ void spin_agreement(const char *method, const Transfer transfer)
 
 int main(int argc, char **argv)
 {
-  if (!cuda_device_present("test_gpu_cpdi"))
-    return skip_code;
   int        usage_error = 0;
   const bool short_form  = short_form_option(argc, argv, "test_gpu_cpdi", &usage_error);
   if (usage_error != 0)
     return usage_error;
+  if (!cuda_device_present("test_gpu_cpdi"))
+    return skip_code;
   step_divisor = short_form ? 10 : 1;
   try
     {

@@ -7,12 +7,12 @@
 
 int main(int argc, char **argv)
 {
-  if (!mpm_test::cuda_device_present("test_gpu_transfer_conservation"))
-    return mpm_test::skip_code;
   int        usage_error = 0;
   const bool short_form  = mpm_test::short_form_option(argc, argv, "test_gpu_transfer_conservation", &usage_error);
   if (usage_error != 0)
     return usage_error;
+  if (!mpm_test::cuda_device_present("test_gpu_transfer_conservation"))
+    return mpm_test::skip_code;
   try
     {
       mpm_test::check_transfer_conservation<mpm_test::CudaTarget>(short_form);
