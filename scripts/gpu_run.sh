@@ -7,7 +7,7 @@
 # The whole build does not fit one call of the device tool (10 minutes): on an H100 with nvcc 13.0
 # three calls of 10, 10 and 8 minutes ended still linking the GPU tests (doc/log.md, 2026-12-05).
 # Within one call, build the test programs on the development VM and carry them over
-# (scripts/gpu_fused_step.sh shows how), or build one target at a time here.
+# (benchmarks/gpu-lab/gpu_fused_step.sh shows how), or build one target at a time here.
 set -u -o pipefail
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
 OUT=${OUT:-$ROOT/output-gpu}

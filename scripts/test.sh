@@ -10,4 +10,4 @@ export OMPI_MCA_pml=ob1
 (cd build && ctest -j "$(nproc)" --output-on-failure --timeout 900)
 # Our code again with AddressSanitizer + UndefinedBehaviorSanitizer in build-asan (only the core
 # tests and the executable), and the core tests and short prm scenes there (doc/guards.md).
-bash scripts/sanitize.sh
+bash scripts/dev/sanitize.sh

@@ -25,7 +25,7 @@ namespace mpm
 #include "method_study_table.inc"
     };
 
-    // The methods of scripts/study.py (METHODS), with what each sets.
+    // The methods of scripts/validation/study.py (METHODS), with what each sets.
     const std::vector<MethodSettings> &methods()
     {
       const auto g = ShapeFunction::gimp, b2 = ShapeFunction::bspline2, b3 = ShapeFunction::bspline3,

@@ -2,7 +2,7 @@
 # as COST by mpm_finish_tests (top-level CMakeLists.txt). A fresh build has no timing history, so
 # ctest would start these in the order they are declared and some would run alone at the end of
 # `ctest -j`; with COST they start first. Only the order changes, never what a test checks.
-if(MPM_SANITIZE) # ASan + UBSan at -O1 (scripts/sanitize.sh)
+if(MPM_SANITIZE) # ASan + UBSan at -O1 (scripts/dev/sanitize.sh)
   set(MPM_TEST_COSTS
     core/test_domain_update 177
     core/test_wall_friction 168

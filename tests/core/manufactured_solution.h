@@ -119,7 +119,7 @@ namespace mpm_test
   };
   struct MmsMethod
   {
-    std::string       key; // scripts/study.py's method name
+    std::string       key; // scripts/validation/study.py's method name
     MmsShape          shape;
     mpm::DomainUpdate domain_update = mpm::DomainUpdate::none;
     double            flip_fraction = 0.99;
@@ -128,7 +128,7 @@ namespace mpm_test
     mpm::AffineMatrix affine        = mpm::AffineMatrix::velocity_gradient;
   };
 
-  // The methods of scripts/study.py (same keys and settings).
+  // The methods of scripts/validation/study.py (same keys and settings).
   inline std::vector<MmsMethod> mms_methods()
   {
     using mpm::DomainUpdate;

@@ -1,5 +1,5 @@
 // The manufactured solution (manufactured_solution.h) per method and resolution, for
-// scripts/study.py's scene "mms": one CSV row per run on standard output. Not a test
+// scripts/validation/study.py's scene "mms": one CSV row per run on standard output. Not a test
 // (test_manufactured_solution asserts the rates); the wall time is the steps' alone.
 //   mms_study [--methods a,b,...] [--cells 8,16,32] [--cfl 0.2] [--periods 1] [--precision 64|32]
 // --precision 32: the step in float (the motion, the body force and the errors in double).

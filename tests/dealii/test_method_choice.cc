@@ -24,7 +24,7 @@ namespace
     double cells, error; // error < 0: unstable
   };
 
-  // scene kind -> method -> rows (CPU, FP64), as scripts/method_table.py reads them.
+  // scene kind -> method -> rows (CPU, FP64), as scripts/dev/method_table.py reads them.
   std::map<std::string, std::map<std::string, std::vector<Row>>> read_study(const std::string &file)
   {
     const std::map<std::string, std::pair<std::string, double>> scenes = {

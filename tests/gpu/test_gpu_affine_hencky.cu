@@ -4,7 +4,7 @@
 // undamped elastic scenes 1e-10, Drucker-Prager and damped ones max(1e-10, 100x the CPU's own
 // spread when its points are reordered). The affine matrices C_p are compared too, relative to
 // the largest |C| of the CPU run. --short: the spinning blocks alone (the affine transfers'
-// scatters), 30 steps each, for compute-sanitizer's racecheck (scripts/gpu_tests_carried.sh).
+// scatters), 30 steps each, for compute-sanitizer's racecheck (scripts/dev/gpu_tests_carried.sh).
 #include "../core/check.h"
 #include "../core/spinning_block.h"
 #include "gpu_agreement.h"

@@ -6,7 +6,7 @@
 // steps (damped: the CPU's reordering spread sets the bound), and the spinning block (its
 // domains rotate with F, undamped), 2D and 3D, with the FLIP blend and with TPIC; CPDI2q in 2D,
 // its corners (state variables) compared too. --short: a tenth of the steps (100 and 30), the same
-// comparisons, for compute-sanitizer's racecheck (scripts/gpu_tests_carried.sh).
+// comparisons, for compute-sanitizer's racecheck (scripts/dev/gpu_tests_carried.sh).
 #include "../core/check.h"
 #include "../core/spinning_block.h"
 #include "gpu_agreement.h"

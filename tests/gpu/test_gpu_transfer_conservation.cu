@@ -1,7 +1,7 @@
 // tests/core/test_transfer_conservation.cc on the device: the same checks
 // (transfer_conservation_checks.h) with the CUDA backend and device storage.
 // --short: 10 steps where the test takes 400-500, for compute-sanitizer's racecheck, which
-// does not finish the whole test in minutes (scripts/gpu_tests_carried.sh).
+// does not finish the whole test in minutes (scripts/dev/gpu_tests_carried.sh).
 #include "../core/transfer_conservation_checks.h"
 #include "gpu_targets.h"
 

@@ -1,13 +1,13 @@
 #!/usr/bin/env python3
 """A run of Solver/Method = auto against its promise: the study's error measure of the scene kind
-(scripts/study.py) on the run's output is at most the tolerance, and the log names the pick.
+(scripts/validation/study.py) on the run's output is at most the tolerance, and the log names the pick.
 Usage: check_method_error.py OUTDIR LOG SCENE TOLERANCE     (SCENE: v3; the other kinds need the study's
 reference runs)"""
 import os
 import sys
 
 here = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, os.path.join(here, "..", "..", "scripts"))
+sys.path.insert(0, os.path.join(here, "..", "..", "scripts", "validation"))
 import study  # noqa: E402
 
 out, log, scene, tolerance = sys.argv[1], sys.argv[2], sys.argv[3], float(sys.argv[4])

@@ -9,7 +9,7 @@ set -eu
 exe=$1 src=$2 out=$3 here=$(dirname "$0")
 bash "$here/run_np.sh" "$exe" "$src/prm/elastic_column_2d.prm" "$out" "1 2 4"
 for np in 1 2 4; do
-  /usr/bin/python3 "$src/scripts/column_error.py" "$out/np$np" --max-error 1e-3
+  /usr/bin/python3 "$src/scripts/validation/column_error.py" "$out/np$np" --max-error 1e-3
 done
 /usr/bin/python3 "$here/compare_np.py" "$out/np1" "$out/np2" "$out/np4" --time 50.0879 --rtol 1e-10
 /usr/bin/python3 "$here/compare_np.py" "$out/np1" "$out/np2" "$out/np4" --rtol 1e-6 --migrated

@@ -1,7 +1,7 @@
 // Solver/Method = auto: the fastest method whose error, as the method study measured it on the
 // study's scene of the same kind at the same resolution, is below a tolerance (doc/methods.md,
 // "Choosing a method"). The study's rows are compiled in (source/method_study_table.inc, written
-// by scripts/method_table.py from doc/study.csv).
+// by scripts/dev/method_table.py from doc/study.csv).
 #pragma once
 
 #include <mpm/core/domain_update.h>
