@@ -3,6 +3,7 @@
 
 #include <deal.II/base/mpi.h>
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -54,6 +55,14 @@ namespace mpm
               << " + largest initial speed " << number(first.v0) << ") m/s)";
         else
           out << " (Solver/Fixed time step)";
+        // The run's step follows its stiffest point (Simulator::setup), which a field drawn at the
+        // points makes stiffer than the mean the forecast knows.
+        const bool random_modulus =
+          std::any_of(p.materials.begin(), p.materials.end(), [](const MaterialParameters<double> &m) {
+            return m.field_parameter == FieldParameter::youngs_modulus;
+          });
+        if (p.adaptive_time_step && random_modulus)
+          out << " with the mean Young's modulus; the run's step is set by its stiffest point's, and shorter";
         out << "; about " << number(std::ceil(first.steps), 10) << " steps to End time = " << number(p.end_time)
             << " s at that step"
             << (first.landing ? " (each cut to land on an output time)" :

@@ -27,16 +27,23 @@ namespace mpm
 
   namespace
   {
-    // The elastic wave speed of points given to setup(): the largest over the points of
-    // sqrt(M / rho), rho = mass / volume of the point.
+    // The elastic wave speed of the CFL condition: the largest over the points of sqrt(M / rho),
+    // M the point's P-wave modulus (its own where Young's modulus is a random field) and rho
+    // the body's density (the prm's bodies: from_prm, one per Material points/Body) or the
+    // point's mass / volume (points handed over).
     template <int dim>
-    double elastic_wave_speed(const std::vector<GeneratedBody<dim>> &bodies, const Parameters &p)
+    double elastic_wave_speed(const std::vector<GeneratedBody<dim>> &bodies, const Parameters &p, const bool from_prm)
     {
       double c = 0;
-      for (const GeneratedBody<dim> &body : bodies)
-        for (int i = 0; i < body.points.size(); ++i)
-          c = std::max(c, std::sqrt(p.materials[body.points.material[i]].elastic.p_wave_modulus() *
-                                    body.points.volume[i] / body.points.mass[i]));
+      for (std::size_t b = 0; b < bodies.size(); ++b)
+        {
+          const HostPoints<dim, double> &points = bodies[b].points;
+          for (int i = 0; i < points.size(); ++i)
+            {
+              const double M = point_p_wave_modulus(p.materials[points.material[i]], points.material_field[i]);
+              c = std::max(c, std::sqrt(from_prm ? M / p.bodies[b].density : M * points.volume[i] / points.mass[i]));
+            }
+        }
       return c;
     }
 
@@ -215,16 +222,7 @@ namespace mpm
                 body.points.domain_half_length[d][i] *= scale;
                 body.points.initial_domain_half_length[d][i] *= scale;
               }
-        s.c_el = elastic_wave_speed(*given_bodies, parameters);
       }
-    else
-      s.c_el = elastic_wave_speed(parameters);
-    if (!parameters.adaptive_time_step)
-      AssertThrow(parameters.fixed_time_step * s.c_el <= s.h,
-                  dealii::ExcMessage("Parameter 'Solver/Fixed time step': " +
-                                     dealii::Utilities::to_string(parameters.fixed_time_step) +
-                                     " s exceeds the elastic stability limit h / c_el = " +
-                                     dealii::Utilities::to_string(s.h / s.c_el) + " s (CFL > 1)."));
     check_backend(parameters.backend); // before any set-up
 
     // Set-up. The CUDA context is created on a thread of its own (0.3-0.5 s on the GPU
@@ -272,6 +270,13 @@ namespace mpm
       AssertThrow(s.n_points_initial > 0,
                   dealii::ExcMessage("Parameter 'Material points': the bodies contain no material point (each "
                                      "body must cover at least one point site of the grid)."));
+      s.c_el = elastic_wave_speed(generation.get(), parameters, given_bodies == nullptr);
+      if (!parameters.adaptive_time_step)
+        AssertThrow(parameters.fixed_time_step * s.c_el <= s.h,
+                    dealii::ExcMessage("Parameter 'Solver/Fixed time step': " +
+                                       dealii::Utilities::to_string(parameters.fixed_time_step) +
+                                       " s exceeds the elastic stability limit h / c_el = " +
+                                       dealii::Utilities::to_string(s.h / s.c_el) + " s (CFL > 1)."));
     };
 
     // One rank: the engine keeps its own nodes on the lattice and starts from the bodies,

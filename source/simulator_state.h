@@ -75,15 +75,6 @@ namespace mpm
       const std::streamsize precision;
     };
 
-    // Largest elastic wave speed over the bodies, sqrt((K + 4G/3) / rho).
-    inline double elastic_wave_speed(const Parameters &p)
-    {
-      double c = 0;
-      for (unsigned int b = 0; b < p.bodies.size(); ++b)
-        c = std::max(c, std::sqrt(p.materials[p.body_material[b]].elastic.p_wave_modulus() / p.bodies[b].density));
-      return c;
-    }
-
     // Deletes the run's TimerOutput, except while an exception unwinds the stack (an error on
     // its way to the user): there deal.II's destructor skips the timing summary (a collective
     // MPI call that not every rank might reach) and prints instead its seven-line banner

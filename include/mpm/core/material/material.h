@@ -95,6 +95,16 @@ namespace mpm
     return m;
   }
 
+  // The P-wave modulus K + 4G/3 of a point whose field value is `value`: the stiffness of its
+  // fastest elastic wave, which bounds the explicit step (CFL). A random field of Young's
+  // modulus makes it the point's own, not the material's mean.
+  template <typename Real>
+  MPM_HOST_DEVICE inline Real point_p_wave_modulus(const MaterialParameters<Real> &m, const Real value)
+  {
+    return m.field_parameter == FieldParameter::youngs_modulus ? with_field_value(m, value).elastic.p_wave_modulus() :
+                                                                   m.elastic.p_wave_modulus();
+  }
+
   // The update of a point that knows its whole motion over the step (the MPM step): the
   // material's elastic law picks the Jaumann rate form or Hencky's. all_laws = false leaves
   // Hencky's law and Mohr-Coulomb out of the compiled code (the device's standard kernels,
