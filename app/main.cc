@@ -4,10 +4,10 @@
 //   dealii-mpm scene.prm --check      check it without running it (run_forecast.h)
 //   dealii-mpm --print-parameters [2|3] [prm|description|json]
 //   dealii-mpm --help
-#include <mpm/dealii/parameters.h>
 #include <mpm/dealii/run_forecast.h>
 #include <mpm/dealii/simulator.h>
-#include <mpm/fem/continuation.h>
+#include <mpm/run/prefailure_then_mpm.h>
+#include <mpm/run/scene.h>
 
 #include <deal.II/base/mpi.h>
 
@@ -101,7 +101,7 @@ int main(int argc, char **argv)
               return 2;
             }
           if (root)
-            mpm::print_parameters(std::cout, std::stoi(dim), style);
+            mpm::print_scene_parameters(std::cout, std::stoi(dim), style);
           return 0;
         }
       // scene.prm, scene.prm --resume DIR (either order), or scene.prm --check.
@@ -129,10 +129,12 @@ int main(int argc, char **argv)
             }
           return 2;
         }
-      const mpm::Parameters parameters = mpm::read_parameters(prm);
+      const mpm::Scene      scene      = mpm::read_scene(prm);
+      const bool            prefailure = scene.prefailure.analysis != mpm::fem::Analysis::none;
+      const mpm::Parameters &parameters = scene.mpm;
       if (check)
         {
-          mpm::print_run_forecast(std::cout, parameters, MPI_COMM_WORLD);
+          mpm::print_run_forecast(std::cout, parameters, MPI_COMM_WORLD, prefailure);
           return 0;
         }
       const auto            catch_signals = [] {
@@ -142,8 +144,8 @@ int main(int argc, char **argv)
       // A pre-failure analysis has no checkpoints: a signal stops it at once, and only its MPM
       // stage catches signals (and is resumed without the analysis).
       bool ran_to_end = true;
-      if (parameters.prefailure.analysis != mpm::fem::Analysis::none)
-        ran_to_end = mpm::fem::run_prefailure_analysis(parameters, MPI_COMM_WORLD, resume, catch_signals);
+      if (prefailure)
+        ran_to_end = mpm::run_prefailure_analysis(scene, MPI_COMM_WORLD, resume, catch_signals);
       else
         {
           catch_signals();
@@ -152,7 +154,7 @@ int main(int argc, char **argv)
       if (!ran_to_end)
         {
           if (root)
-            std::cout << "  continue with: dealii-mpm " << prm << " --resume " << parameters.checkpoint_directory
+            std::cout << "  continue with: dealii-mpm " << prm << " --resume " << parameters.checkpoint.directory
                       << std::endl;
           return exit_stopped;
         }

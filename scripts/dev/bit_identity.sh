@@ -30,7 +30,8 @@ fi
 exe=$(realpath "$1") out=$2 steps=${STEPS:-60}
 mkdir -p "$out"
 for prm in "$here"/prm/*.prm "$here"/tests/prm/*.prm; do
-  name=$(basename "$(dirname "$prm")")_$(basename "$prm" .prm)
+  rel=${prm#"$here"/}
+  name=$(echo "${rel%.prm}" | tr / _)
   dir="$out/$name"
   start=$(date +%s.%N)
   bash "$here/tests/prm/run_scene.sh" "$exe" "$prm" "$dir" 1 \

@@ -1,9 +1,9 @@
 #!/usr/bin/env python3
-"""Writes the study's table that Solver/Method = auto chooses from (source/method_study_table.inc) out of
+"""Writes the study's table that Solver/Method = auto chooses from (source/dealii/method_study_table.inc) out of
 doc/study.csv: per scene kind and method, the error at each resolution (cells across the bodies' largest
 extent) and the cost per point and step relative to uGIMP with the FLIP/PIC blend, per backend.
 
-Usage: method_table.py [CSV] [OUT]     (default doc/study.csv, source/method_study_table.inc; OUT '-': stdout)
+Usage: method_table.py [CSV] [OUT]     (default doc/study.csv, source/dealii/method_study_table.inc; OUT '-': stdout)
 A ctest (prm/method_table_in_sync) checks that the file in the repository is what this script writes.
 """
 import csv
@@ -13,7 +13,7 @@ import sys
 
 root = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..")
 source = sys.argv[1] if len(sys.argv) > 1 else os.path.join(root, "doc", "study.csv")
-target = sys.argv[2] if len(sys.argv) > 2 else os.path.join(root, "source", "method_study_table.inc")
+target = sys.argv[2] if len(sys.argv) > 2 else os.path.join(root, "source", "dealii", "method_study_table.inc")
 
 # The study's scenes as Method scene names them, with the largest extent of their bodies (m): the study's
 # resolutions become cells across it, as the program measures a scene's.

@@ -154,15 +154,15 @@ namespace mpm::fem
     }
 
     template <int dim>
-    void mesh_body(const Parameters &parameters, Triangulation<dim> &mesh)
+    void mesh_body(const PrefailureScene &scene, Triangulation<dim> &mesh)
     {
       const std::string where = "Material points/Body 1/";
-      if (parameters.bodies.size() != 1)
+      if (scene.bodies.size() != 1)
         fail("Pre-failure analysis/Mesh", "Mesh = prm bodies meshes one body; the scene has " +
-                                            std::to_string(parameters.bodies.size()) +
+                                            std::to_string(scene.bodies.size()) +
                                             ". For several materials give a mesh file (Mesh = mesh file).");
-      const BodyParameters &body = parameters.bodies[0];
-      const double h = parameters.prefailure.cell_size > 0 ? parameters.prefailure.cell_size : parameters.cell_size;
+      const MeshedBody &body = scene.bodies[0];
+      const double      h    = scene.settings.cell_size > 0 ? scene.settings.cell_size : scene.default_cell_size;
       if (body.shape == "box")
         {
           std::vector<unsigned int> cells(dim);
@@ -236,18 +236,18 @@ namespace mpm::fem
   }
 
   template <int dim>
-  std::map<types::material_id, FemMaterial> create_mesh(const Parameters &parameters,
+  std::map<types::material_id, FemMaterial> create_mesh(const PrefailureScene &scene,
                                                         parallel::distributed::Triangulation<dim> &triangulation)
   {
-    const PrefailureParameters &fem = parameters.prefailure;
+    const PrefailureParameters &fem = scene.settings;
     Triangulation<dim>          coarse;
     std::map<types::material_id, FemMaterial> materials;
     const auto material = [&](const unsigned int index, const double density) {
       FemMaterial m;
-      m.parameters   = parameters.materials[index];
+      m.parameters   = scene.materials[index];
       m.density      = density;
       m.mpm_material = index;
-      m.name         = parameters.material_names[index];
+      m.name         = scene.material_names[index];
       return m;
     };
     if (fem.mesh == "mesh file")
@@ -258,8 +258,8 @@ namespace mpm::fem
           ids.insert(cell->material_id());
         for (const types::material_id id : ids)
           {
-            const auto named = parameters.fem_materials.find(id);
-            if (named == parameters.fem_materials.end())
+            const auto named = scene.mesh_materials.find(id);
+            if (named == scene.mesh_materials.end())
               fail("Initial state/Materials",
                    "the cells of material_id " + std::to_string(id) + " in '" + fem.mesh_file +
                      "' have no material; name every id as 'id: material name, density' (a mesh file without "
@@ -269,14 +269,11 @@ namespace mpm::fem
       }
     else
       {
-        mesh_body(parameters, coarse);
+        mesh_body(scene, coarse);
         set_bounding_box_boundary_ids(coarse);
         for (const auto &cell : coarse.active_cell_iterators())
           cell->set_material_id(0);
-        unsigned int index = 0;
-        while (parameters.material_names[index] != parameters.bodies[0].material)
-          ++index;
-        materials[0] = material(index, parameters.bodies[0].density);
+        materials[0] = material(scene.bodies[0].material, scene.bodies[0].density);
       }
     for (const auto &[id, m] : materials)
       if (m.parameters.model == MaterialModel::user_defined)
@@ -306,8 +303,8 @@ namespace mpm::fem
 
   template void set_bounding_box_boundary_ids(Triangulation<2> &);
   template void set_bounding_box_boundary_ids(Triangulation<3> &);
-  template std::map<types::material_id, FemMaterial> create_mesh(const Parameters &,
+  template std::map<types::material_id, FemMaterial> create_mesh(const PrefailureScene &,
                                                                  parallel::distributed::Triangulation<2> &);
-  template std::map<types::material_id, FemMaterial> create_mesh(const Parameters &,
+  template std::map<types::material_id, FemMaterial> create_mesh(const PrefailureScene &,
                                                                  parallel::distributed::Triangulation<3> &);
 } // namespace mpm::fem

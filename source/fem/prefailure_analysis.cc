@@ -37,13 +37,13 @@ namespace mpm::fem
   } // namespace
 
   template <int dim>
-  PrefailureAnalysis<dim>::PrefailureAnalysis(const Parameters &parameters, const MPI_Comm communicator)
-    : parameters(parameters)
+  PrefailureAnalysis<dim>::PrefailureAnalysis(const PrefailureScene &scene, const MPI_Comm communicator)
+    : scene(scene)
     , communicator(communicator)
     , triangulation(communicator)
   {
-    fem_materials = create_mesh(parameters, triangulation);
-    if (parameters.prefailure.analysis == Analysis::strength_reduction)
+    fem_materials = create_mesh(scene, triangulation);
+    if (scene.settings.analysis == Analysis::strength_reduction)
       {
         std::string elastic;
         bool        any_strength = false;
@@ -57,14 +57,14 @@ namespace mpm::fem
                                "but no material of the mesh has them (" + elastic + ": linear elastic); give one a "
                                "strength (Materials/Material <name>/Model = drucker prager or mohr coulomb)."));
       }
-    quasi_static  = std::make_unique<QuasiStaticSolver<dim>>(triangulation, fem_materials, parameters.prefailure,
-                                                            parameters.gravity);
+    quasi_static  = std::make_unique<QuasiStaticSolver<dim>>(triangulation, fem_materials, scene.settings,
+                                                            scene.gravity);
   }
 
   template <int dim>
   void PrefailureAnalysis<dim>::initial_stresses(const double strength_factor, PrefailureResult &result)
   {
-    const PrefailureParameters &p = parameters.prefailure;
+    const PrefailureParameters &p = scene.settings;
     ConditionalOStream pcout(std::cout, Utilities::MPI::this_mpi_process(communicator) == 0);
     const Analysis     how = p.analysis == Analysis::strength_reduction ? p.initial_stresses : p.analysis;
     if (how == Analysis::k0_procedure)
@@ -118,7 +118,7 @@ namespace mpm::fem
   template <int dim>
   void PrefailureAnalysis<dim>::strength_reduction(PrefailureResult &result)
   {
-    const PrefailureParameters &p = parameters.prefailure;
+    const PrefailureParameters &p = scene.settings;
     ConditionalOStream pcout(std::cout, Utilities::MPI::this_mpi_process(communicator) == 0);
     quasi_static->set_monitor_reference();
     result.curve.push_back({p.minimum_factor, true, result.initial_steps.back().iterations,
@@ -168,7 +168,7 @@ namespace mpm::fem
   {
     if (Utilities::MPI::this_mpi_process(communicator) != 0)
       return;
-    std::ofstream out(parameters.output_directory + "/strength_reduction.csv");
+    std::ofstream out(scene.output_directory + "/strength_reduction.csv");
     out << "factor,converged,newton_iterations,initial_stiffness_iterations,relative_residual,monitor_displacement,"
            "max_plastic_strain,wall_s\n"
         << std::setprecision(10);
@@ -176,17 +176,17 @@ namespace mpm::fem
       out << s.factor << ',' << (s.converged ? 1 : 0) << ',' << s.iterations << ',' << s.initial_stiffness_iterations
           << ',' << s.residual << ',' << s.monitor_displacement << ',' << s.max_plastic_strain << ',' << s.wall_seconds
           << '\n';
-    AssertThrow(out, ExcMessage("Cannot write " + parameters.output_directory + "/strength_reduction.csv."));
+    AssertThrow(out, ExcMessage("Cannot write " + scene.output_directory + "/strength_reduction.csv."));
   }
 
   template <int dim>
   PrefailureResult PrefailureAnalysis<dim>::run()
   {
     Timer                       timer;
-    const PrefailureParameters &p = parameters.prefailure;
+    const PrefailureParameters &p = scene.settings;
     ConditionalOStream pcout(std::cout, Utilities::MPI::this_mpi_process(communicator) == 0);
     if (Utilities::MPI::this_mpi_process(communicator) == 0)
-      std::filesystem::create_directories(parameters.output_directory);
+      std::filesystem::create_directories(scene.output_directory);
     MPI_Barrier(communicator);
     pcout << "Pre-failure analysis (" << to_string(p.analysis) << "): " << triangulation.n_global_active_cells()
           << " cells, FE_Q(" << p.degree << ")^" << dim << ", " << quasi_static->n_dofs() << " unknowns, "
@@ -196,14 +196,14 @@ namespace mpm::fem
     PrefailureResult result;
     const double     initial_factor = p.analysis == Analysis::strength_reduction ? p.minimum_factor : 1.0;
     initial_stresses(initial_factor, result);
-    result.files.push_back(quasi_static->write_output(parameters.output_directory, "prefailure_initial"));
+    result.files.push_back(quasi_static->write_output(scene.output_directory, "prefailure_initial"));
     if (p.analysis == Analysis::strength_reduction)
       {
         strength_reduction(result);
         write_curve(result);
-        result.files.push_back(parameters.output_directory + "/strength_reduction.csv");
+        result.files.push_back(scene.output_directory + "/strength_reduction.csv");
         result.files.push_back(
-          quasi_static->write_output(parameters.output_directory, "prefailure_failure_mechanism"));
+          quasi_static->write_output(scene.output_directory, "prefailure_failure_mechanism"));
       }
     result.wall_seconds = timer.wall_time();
     pcout << "Pre-failure analysis done in " << std::setprecision(3) << result.wall_seconds << " s; files:";

@@ -20,7 +20,7 @@ namespace mpm_test
     p.cell_size = cell_size;
     p.boundary.fill(mpm::BoundaryType::free);
     p.gravity      = std::vector<double>(dim, 0.0);
-    p.point_weight = 20;
+    p.parallel.point_weight = 20;
     return p;
   }
 

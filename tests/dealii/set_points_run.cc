@@ -28,10 +28,10 @@ int main(int argc, char **argv)
       AssertThrow(argc == 2, dealii::ExcMessage("usage: set_points_run OUTPUT_DIRECTORY"));
       Parameters p = read_parameters(std::string(MPM_SOURCE_DIR) + "/tests/prm/collapse_small_2d.prm");
       p.max_steps            = 40;
-      p.output_directory     = argv[1];
-      p.output_interval      = 0;
-      p.progress_interval    = 0;
-      p.write_particle_table = true;
+      p.output.directory     = argv[1];
+      p.output.interval      = 0;
+      p.output.progress_interval    = 0;
+      p.output.write_particle_table = true;
       Simulator<2> simulator(p, comm);
       simulator.setup();
 

@@ -36,9 +36,9 @@ namespace
   unsigned int cells_moved_by_repartition(const unsigned int cells_per_direction, const int cells_per_grid_cell = 1)
   {
     mpm::Parameters p          = mpm_test::box_domain<dim>(1.0, 1.0 / cells_per_direction);
-    p.load_balance_threshold   = 1.02;
+    p.parallel.load_balance_threshold   = 1.02;
     p.cells_per_grid_cell      = cells_per_grid_cell;
-    const double point_weight  = p.point_weight;
+    const double point_weight  = p.parallel.point_weight;
     // A pile: in the lattice cells with x_0 + x_1 < 1 (the others empty), more points towards
     // the origin, away from the cells' faces (each point's cell is unambiguous).
     mpm::HostPoints<dim, double> points;

@@ -29,11 +29,11 @@ namespace
   {
     Parameters p = read_parameters(std::string(MPM_SOURCE_DIR) + "/tests/prm/collapse_small_2d.prm");
     p.max_steps            = 60;
-    p.output_directory     = directory;
-    p.output_interval      = 0;
-    p.progress_interval    = 0;
-    p.write_particles      = false;
-    p.write_grid_fields    = false;
+    p.output.directory     = directory;
+    p.output.interval      = 0;
+    p.output.progress_interval    = 0;
+    p.output.write_particles      = false;
+    p.output.write_grid_fields    = false;
     return p;
   }
 

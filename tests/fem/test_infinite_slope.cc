@@ -13,7 +13,7 @@
 //     (Davis' non-associated correction). Within 2%.
 // The strength reduction's last step (below twice Factor tolerance, 0.005) bounds how far
 // below the true collapse factor the last converged F lies.
-#include <mpm/dealii/parameters.h>
+#include <mpm/run/scene.h>
 #include <mpm/fem/prefailure_analysis.h>
 
 #include <deal.II/base/mpi.h>
@@ -68,7 +68,7 @@ namespace
   template <int dim>
   double factor_of_safety(const double psi_deg)
   {
-    mpm::fem::PrefailureAnalysis<dim> analysis(mpm::parameters_from_string(slope(dim, psi_deg)), MPI_COMM_WORLD);
+    mpm::fem::PrefailureAnalysis<dim> analysis(mpm::prefailure_scene(mpm::scene_from_string(slope(dim, psi_deg))), MPI_COMM_WORLD);
     return analysis.run().factor_of_safety;
   }
 

@@ -9,7 +9,7 @@
 //     residuals, log(r_k+1 / r_k) / log(r_k / r_k-1), is >= 1.7 over the last two iterations
 //     (quadratic: 2; a tangent that is not the consistent one gives 1).
 // On any number of MPI ranks (ctest runs 1 and 2): each rank checks its own quadrature points.
-#include <mpm/dealii/parameters.h>
+#include <mpm/run/scene.h>
 #include <mpm/fem/prefailure_analysis.h>
 
 #include "v7_slope_prm.h"
@@ -89,7 +89,7 @@ namespace
   template <int dim>
   void elastic_layer()
   {
-    mpm::fem::PrefailureAnalysis<dim> analysis(mpm::parameters_from_string(layer(dim, "gravity loading", "linear elastic")),
+    mpm::fem::PrefailureAnalysis<dim> analysis(mpm::prefailure_scene(mpm::scene_from_string(layer(dim, "gravity loading", "linear elastic"))),
                                                MPI_COMM_WORLD);
     const mpm::fem::PrefailureResult result = analysis.run();
     const double                     error  = layer_stress_error(analysis.solver(), nu / (1 - nu));
@@ -101,7 +101,7 @@ namespace
   template <int dim>
   void k0_layer()
   {
-    mpm::fem::PrefailureAnalysis<dim> analysis(mpm::parameters_from_string(layer(dim, "K0 procedure", "mohr coulomb")),
+    mpm::fem::PrefailureAnalysis<dim> analysis(mpm::prefailure_scene(mpm::scene_from_string(layer(dim, "K0 procedure", "mohr coulomb"))),
                                                MPI_COMM_WORLD);
     const mpm::fem::PrefailureResult result = analysis.run();
     const double                     error  = layer_stress_error(analysis.solver(), 0.55);
@@ -116,7 +116,7 @@ namespace
   {
     const std::string prm = v7_drucker_prager_slope("  set Method = gravity loading\n  set Residual tolerance = 1e-12",
                                                     "test-prefailure-output");
-    mpm::fem::PrefailureAnalysis<2> analysis(mpm::parameters_from_string(prm), MPI_COMM_WORLD);
+    mpm::fem::PrefailureAnalysis<2> analysis(mpm::prefailure_scene(mpm::scene_from_string(prm)), MPI_COMM_WORLD);
     const mpm::fem::PrefailureResult result = analysis.run();
     const std::vector<double>       &r      = result.initial_steps.back().residuals;
     std::string                      history;

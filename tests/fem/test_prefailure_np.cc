@@ -5,7 +5,7 @@
 //  - the same stresses at every quadrature point of the state at the last converged factor,
 //    to 1e-8 of gamma H (matched by the quadrature point's position).
 // ctest runs it on 2 and 4 ranks.
-#include <mpm/dealii/parameters.h>
+#include <mpm/run/scene.h>
 #include <mpm/fem/prefailure_analysis.h>
 
 #include "v7_slope_prm.h"
@@ -63,7 +63,7 @@ int main(int argc, char **argv)
   const unsigned int               rank = Utilities::MPI::this_mpi_process(MPI_COMM_WORLD);
   const unsigned int               np   = Utilities::MPI::n_mpi_processes(MPI_COMM_WORLD);
 
-  mpm::fem::PrefailureAnalysis<2> parallel(mpm::parameters_from_string(slope("test-prefailure-np-output")),
+  mpm::fem::PrefailureAnalysis<2> parallel(mpm::prefailure_scene(mpm::scene_from_string(slope("test-prefailure-np-output"))),
                                            MPI_COMM_WORLD);
   const double F_parallel = parallel.run().factor_of_safety;
   // Every rank's stresses to rank 0.
@@ -72,7 +72,7 @@ int main(int argc, char **argv)
   int failures = 0;
   if (rank == 0)
     {
-      mpm::fem::PrefailureAnalysis<2> serial(mpm::parameters_from_string(slope("test-prefailure-np-serial")),
+      mpm::fem::PrefailureAnalysis<2> serial(mpm::prefailure_scene(mpm::scene_from_string(slope("test-prefailure-np-serial"))),
                                              MPI_COMM_SELF);
       const double   F_serial  = serial.run().factor_of_safety;
       const Stresses reference = stresses(serial.solver());

@@ -6,7 +6,7 @@
 
 #include <mpm/core/host_storage.h>
 #include <mpm/core/material/material.h>
-#include <mpm/core/step.h>
+#include <mpm/core/step/settings.h>
 
 namespace mpm
 {

@@ -6,7 +6,7 @@
 #pragma once
 
 #include <mpm/core/config.h>
-#include <mpm/core/step.h>
+#include <mpm/core/step/settings.h>
 
 namespace mpm
 {

@@ -13,11 +13,13 @@
 // sym(grad u), and the quadrature point's stress, plastic strain and state variables. The MPM background grid
 // is the prm's (Grid), independent of the FEM mesh; points outside it are refused by setup().
 // Placement (b), points on the MPM's lattice with the state projected: fem_handover_lattice.h.
-// Header-only: it is instantiated for the user's vector type.
+// The state a quadrature point gives: handover/quadrature_point_state.h. Header-only: it is
+// instantiated for the user's vector type.
 #pragma once
 
 #include <mpm/core/config.h>
 #include <mpm/dealii/material_points.h>
+#include <mpm/handover/quadrature_point_state.h>
 
 #include <deal.II/base/exceptions.h>
 #include <deal.II/base/quadrature.h>
@@ -37,31 +39,6 @@
 
 namespace mpm
 {
-  // The state of one quadrature point as the MPM takes it over.
-  struct QuadraturePointState
-  {
-    // Cauchy stress (Pa, compression negative), Voigt order xx, yy, zz, xy, yz, xz; in 2D
-    // (plane strain) give zz as well.
-    double stress[n_voigt] = {0, 0, 0, 0, 0, 0};
-    // Accumulated equivalent plastic strain (softening reads it).
-    double plastic_strain = 0;
-    // The further state variables of the MPM material's model, in the order its
-    // state_variables() lists them (user_model.h); empty for the built-in models. Every
-    // quadrature point gives as many as the run's models declare (Parameters::state_variable_names).
-    std::vector<double> state_variables;
-  };
-
-  // What the cells of one material_id of the FEM mesh become in the MPM.
-  struct HandoverMaterial
-  {
-    unsigned int material; // index of the MPM material: Materials/Names order of the prm
-    double       density;  // kg/m^3 in the mesh's reference configuration
-  };
-
-  template <int dim>
-  using QuadraturePointStateFunction =
-    std::function<QuadraturePointState(const typename dealii::DoFHandler<dim>::active_cell_iterator &, unsigned int)>;
-
   namespace internal
   {
     template <typename VectorType, typename = void>

@@ -1,4 +1,4 @@
-// Constitutive models by name. Each built-in model lives in one file under source/materials/
+// Constitutive models by name. Each built-in model lives in one file under source/dealii/materials/
 // that declares its prm entries, parses them into the core's MaterialParameters and registers
 // itself with MPM_REGISTER_MATERIAL; nothing else needs to change.
 //

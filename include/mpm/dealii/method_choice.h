@@ -1,13 +1,13 @@
 // Solver/Method = auto: the fastest method whose error, as the method study measured it on the
 // study's scene of the same kind at the same resolution, is below a tolerance (doc/methods.md,
-// "Choosing a method"). The study's rows are compiled in (source/method_study_table.inc, written
+// "Choosing a method"). The study's rows are compiled in (source/dealii/method_study_table.inc, written
 // by scripts/dev/method_table.py from doc/study.csv).
 #pragma once
 
 #include <mpm/core/domain_update.h>
 #include <mpm/core/material/hencky.h>
 #include <mpm/core/shape_functions.h>
-#include <mpm/core/step.h>
+#include <mpm/core/step/settings.h>
 
 #include <string>
 #include <vector>

@@ -15,6 +15,7 @@
 #include <mpm/core/diagnostics.h>
 #include <mpm/dealii/background_grid.h>
 #include <mpm/dealii/material_points.h>
+#include <mpm/dealii/output_settings.h>
 
 #include <deal.II/base/data_out_base.h>
 
@@ -127,8 +128,10 @@ namespace mpm
   class OutputWriter
   {
   public:
-    // resuming: the run continues a checkpoint (resume() follows); history.csv's rows are kept.
-    OutputWriter(const Parameters &parameters, MPI_Comm communicator, bool resuming = false);
+    // yield_to_steps: the background writers run at a lower priority (nice 10), so that they do
+    // not take the core of the thread that queues the steps (Backend = cuda). resuming: the run
+    // continues a checkpoint (resume() follows); history.csv's rows are kept.
+    OutputWriter(const OutputSettings &settings, bool yield_to_steps, MPI_Comm communicator, bool resuming = false);
 
     // What a checkpoint keeps of the output: outputs written and the .pvd records.
     struct Records

@@ -5,13 +5,18 @@
 
 #include <mpm/core/material/material.h>
 #include <mpm/core/shape_functions.h>
-#include <mpm/core/step.h>
-#include <mpm/fem/prefailure_parameters.h>
+#include <mpm/core/step/settings.h>
+#include <mpm/dealii/backend_settings.h>
+#include <mpm/dealii/checkpoint_settings.h>
+#include <mpm/dealii/initial_state_settings.h>
+#include <mpm/dealii/output_settings.h>
+#include <mpm/dealii/parallel_settings.h>
 #include <mpm/fields/gaussian_random_field.h>
 
 #include <deal.II/base/parameter_handler.h>
 
 #include <array>
+#include <functional>
 #include <map>
 #include <string>
 #include <vector>
@@ -93,62 +98,22 @@ namespace mpm
     std::vector<BodyParameters>             bodies;
     std::vector<unsigned int>               body_material; // index into materials
 
-    // Output
-    std::string  output_directory;
-    double       output_interval;
-    bool         write_grid_fields;
-    bool         write_particles;
-    unsigned int history_every;
-    double       progress_interval;
-    bool         write_particle_table;
-    std::vector<std::string> particle_fields; // Output/Particle fields: those written to the .vtu (empty: all)
-    std::string  output_compression;   // zlib level of the .vtu files: "best speed", ...
-    bool         output_in_background; // compress and write files on a background thread
-    unsigned int output_files_per_rank; // .vtu pieces per rank and output, written in parallel
-    unsigned int max_outputs = 10000;   // warn of more outputs than this; 0 = no warning
+    OutputSettings output; // Output
 
     // Resources (guards.h)
     double memory_limit = 0; // GB for the whole run; 0 = each node's available memory
 
-    // Checkpoint (doc/checkpoints.md)
-    unsigned int checkpoint_step_interval = 0;    // steps between checkpoints; 0 = none by steps
-    double       checkpoint_wall_interval = 0;    // wall-clock minutes between checkpoints; 0 = none
-    unsigned int checkpoint_keep          = 2;    // newest checkpoints kept
-    std::string  checkpoint_directory;            // "" = <Output/Directory>/checkpoints
-    bool         checkpoint_at_end        = false; // one more at the end of the run
-
-    // Parallel runs (doc/performance.md, MPI)
-    double resort_distance;        // re-sort at this fraction of the safe distance outside a home cell
-    double load_balance_threshold; // repartition when max/mean work per rank exceeds it; 0 = never
-    double point_weight;           // work of one point relative to one empty cell
+    CheckpointSettings checkpoint; // Checkpoint (doc/checkpoints.md)
+    ParallelSettings   parallel;   // Parallel: MPI runs (doc/performance.md, MPI)
 
     // Not a prm entry: the materials' strengths are the prm's divided by this (a pre-failure
-    // analysis's hand-over sets it, fem/continuation.cc). Checkpoints record it, and a resumed
+    // analysis's hand-over sets it, run/prefailure_then_mpm.cc). Checkpoints record it, and a resumed
     // run must have the same (--resume of such a scene skips the FEM and sets it from there).
     double strength_divisor = 1;
 
-    // Initial state: "prm bodies" (Material points) or "FEM file" (fem_state_file.h)
-    std::string  initial_state_source = "prm bodies";
-    std::string  fem_file;
-    std::string  fem_placement = "quadrature points"; // or "lattice"
-    unsigned int fem_points_per_direction = 2;
-    int          fem_projection_degree    = -1;
-    // Damped steps at t = 0 until the points rest in the MPM's own equilibrium (Simulator)
-    bool         equilibrate                 = false;
-    double       equilibration_damping       = 0.8;
-    double       equilibration_tolerance     = 1e-6; // largest point speed / sqrt(|g| H)
-    unsigned int equilibration_maximum_steps = 100000;
-    // FEM material_id -> (index into materials, density)
-    std::map<unsigned int, std::pair<unsigned int, double>> fem_materials;
+    InitialStateSettings initial_state; // Initial state
 
-    // The FEM stage before the MPM (subsection Pre-failure analysis; mpm/fem/)
-    fem::PrefailureParameters prefailure;
-
-    // Backend
-    std::string backend;
-    int         sort_interval = 20; // cuda: steps between re-sorts of the points on the device
-    bool        queue_steps   = true; // cuda, one rank: steps queued before the last one ends
-    bool        single_precision = false; // Backend/Precision = float: points, nodes and step in float
+    BackendSettings backend; // Backend
 
     // The state variables every point of the run carries (user_model.h): their names, the
     // longest list the materials' models declare (where two models name variable k
@@ -170,13 +135,26 @@ namespace mpm
     void parse(dealii::ParameterHandler &prm);
   };
 
-  // Two-pass read of a parameter file: the first pass finds the dimension, the number
-  // of bodies and the material names, the second declares and reads everything,
-  // rejecting unknown entries. Throws with a message naming the offending entry.
-  Parameters read_parameters(const std::string &filename);
-  // The same from the text of a parameter file (a program that writes its scene in C++).
-  Parameters parameters_from_string(const std::string &text);
+  // A subsection of the same parameter file that a part of the program above this layer reads
+  // for itself (the pre-failure FEM stage's: run/scene.h): declared beside the MPM's entries, so
+  // that one file describes the whole scene, and parsed after them, with the MPM's parameters
+  // to check its entries against. parse throws naming the entry on bad input.
+  struct ParameterSection
+  {
+    std::function<void(dealii::ParameterHandler &prm, unsigned int dim)>           declare;
+    std::function<void(dealii::ParameterHandler &prm, const Parameters &parameters)> parse;
+  };
 
-  // Prints every entry with its default and documentation (for --print-parameters).
-  void print_parameters(std::ostream &out, unsigned int dim, const std::string &style);
+  // Two-pass read of a parameter file: the first pass finds the dimension, the number
+  // of bodies and the material names, the second declares and reads everything (the MPM's
+  // entries and those of `sections`), rejecting unknown entries. Throws with a message naming
+  // the offending entry.
+  Parameters read_parameters(const std::string &filename, const std::vector<ParameterSection> &sections = {});
+  // The same from the text of a parameter file (a program that writes its scene in C++).
+  Parameters parameters_from_string(const std::string &text, const std::vector<ParameterSection> &sections = {});
+
+  // Prints every entry (the MPM's and those of `sections`) with its default and documentation
+  // (for --print-parameters).
+  void print_parameters(std::ostream &out, unsigned int dim, const std::string &style,
+                        const std::vector<ParameterSection> &sections = {});
 } // namespace mpm

@@ -14,6 +14,7 @@
 namespace mpm
 {
   // Runs check_memory on `communicator` (refusing as a run would) and prints the forecast on
-  // rank 0.
-  void print_run_forecast(std::ostream &out, const Parameters &parameters, MPI_Comm communicator);
+  // rank 0. prefailure_stage: the points will come from a pre-failure FEM analysis.
+  void print_run_forecast(std::ostream &out, const Parameters &parameters, MPI_Comm communicator,
+                          bool prefailure_stage = false);
 } // namespace mpm

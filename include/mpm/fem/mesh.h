@@ -3,8 +3,8 @@
 // globally; material ids and boundary ids set (prefailure_parameters.h says which).
 #pragma once
 
-#include <mpm/dealii/parameters.h>
 #include <mpm/fem/fem_material.h>
+#include <mpm/fem/prefailure_scene.h>
 
 #include <deal.II/distributed/tria.h>
 #include <deal.II/grid/tria.h>
@@ -32,6 +32,6 @@ namespace mpm::fem
 
   // Fills the (empty) triangulation and returns the materials of its material ids.
   template <int dim>
-  std::map<dealii::types::material_id, FemMaterial> create_mesh(const Parameters &parameters,
+  std::map<dealii::types::material_id, FemMaterial> create_mesh(const PrefailureScene &scene,
                                                                 dealii::parallel::distributed::Triangulation<dim> &triangulation);
 } // namespace mpm::fem

@@ -1,13 +1,13 @@
-// The pre-failure analysis a parameter file asks for (subsection Pre-failure analysis): the
-// mesh, the solver, then gravity loading, the K0 procedure or a shear strength reduction,
-// with its log and output files (Output/Directory):
+// The pre-failure analysis a scene asks for (PrefailureScene; in a parameter file, subsection
+// Pre-failure analysis, read by run/scene.h): the mesh, the solver, then gravity loading, the
+// K0 procedure or a shear strength reduction, with its log and output files (its output folder):
 //   prefailure_initial_*.pvtu        the state after gravity loading or the K0 procedure
 //   strength_reduction.csv           factor, converged, iterations, monitor displacement, ...
 //   prefailure_failure_mechanism_*.pvtu  the state at the last converged factor
 // The committed state is then the one the MPM can take over (solver().state_function()).
 #pragma once
 
-#include <mpm/dealii/parameters.h>
+#include <mpm/fem/prefailure_scene.h>
 #include <mpm/fem/quasi_static_solver.h>
 
 #include <deal.II/distributed/tria.h>
@@ -50,7 +50,7 @@ namespace mpm::fem
   class PrefailureAnalysis
   {
   public:
-    PrefailureAnalysis(const Parameters &parameters, MPI_Comm communicator);
+    PrefailureAnalysis(const PrefailureScene &scene, MPI_Comm communicator);
 
     // Runs the analysis of Pre-failure analysis/Method and writes its files; throws where the
     // body cannot carry its initial load (naming what to change).
@@ -66,7 +66,7 @@ namespace mpm::fem
     void strength_reduction(PrefailureResult &result);
     void write_curve(const PrefailureResult &result) const;
 
-    const Parameters                                   parameters;
+    const PrefailureScene                              scene;
     MPI_Comm                                           communicator;
     dealii::parallel::distributed::Triangulation<dim> triangulation;
     std::map<dealii::types::material_id, FemMaterial> fem_materials;

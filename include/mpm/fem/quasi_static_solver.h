@@ -6,7 +6,7 @@
 // GMRES + AMG. Plane strain in 2D (the out-of-plane
 // stress is carried at every quadrature point). Theory: doc/prefailure.md.
 //
-//   QuasiStaticSolver<2> solver(triangulation, materials, parameters.prefailure, parameters.gravity);
+//   QuasiStaticSolver<2> solver(triangulation, materials, scene.settings, scene.gravity);
 //   for (unsigned int s = 1; s <= n; ++s)
 //     solver.solve(double(s) / n, 1.0);      // gravity in load steps
 //   solver.solve(1.0, 1.4);                  // the same with c and tan(phi) divided by 1.4
@@ -16,9 +16,9 @@
 #pragma once
 
 #include <mpm/core/config.h>
-#include <mpm/dealii/fem_handover.h>
 #include <mpm/fem/fem_material.h>
 #include <mpm/fem/prefailure_parameters.h>
+#include <mpm/handover/quadrature_point_state.h>
 
 #include <deal.II/base/quadrature_lib.h>
 #include <deal.II/base/quadrature_point_data.h>

@@ -1,7 +1,7 @@
 // The constitutive models known to the core, dispatched by a model tag so that
 // device code needs no virtual calls. Adding a built-in model: one header with its
 // parameters and MPM_HOST_DEVICE update, one enum value, one case below, and one
-// registration file in the deal.II layer (source/materials/). A model written outside
+// registration file in the deal.II layer (source/dealii/materials/). A model written outside
 // the library (user_model.h) is the tag user_defined and a pointer; CPU backend only.
 #pragma once
 

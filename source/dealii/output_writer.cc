@@ -409,26 +409,27 @@ namespace mpm
   }
 
   template <int dim>
-  OutputWriter<dim>::OutputWriter(const Parameters &parameters, MPI_Comm communicator, const bool resuming)
+  OutputWriter<dim>::OutputWriter(const OutputSettings &settings, const bool yield_to_steps, MPI_Comm communicator,
+                                  const bool resuming)
     : communicator(communicator)
     , rank(dealii::Utilities::MPI::this_mpi_process(communicator))
     , n_ranks(dealii::Utilities::MPI::n_mpi_processes(communicator))
-    , output_directory(parameters.output_directory)
-    , write_grid(parameters.write_grid_fields)
-    , write_particles(parameters.write_particles)
-    , write_table(parameters.write_particle_table)
-    , background(parameters.output_in_background)
-    , particle_fields(parameters.particle_fields)
-    , pieces_per_rank(parameters.output_files_per_rank)
-    , yield_to_steps(parameters.backend == "cuda")
+    , output_directory(settings.directory)
+    , write_grid(settings.write_grid_fields)
+    , write_particles(settings.write_particles)
+    , write_table(settings.write_particle_table)
+    , background(settings.in_background)
+    , particle_fields(settings.particle_fields)
+    , pieces_per_rank(settings.files_per_rank)
+    , yield_to_steps(yield_to_steps)
   {
     if (output_directory.empty())
       output_directory = ".";
     using Flags = dealii::DataOutBase::VtkFlags;
-    vtk_flags.compression_level = parameters.output_compression == "no compression"   ? Flags::no_compression :
-                                  parameters.output_compression == "best compression" ? Flags::best_compression :
-                                  parameters.output_compression == "default"          ? Flags::default_compression :
-                                                                                        Flags::best_speed;
+    vtk_flags.compression_level = settings.compression == "no compression"   ? Flags::no_compression :
+                                  settings.compression == "best compression" ? Flags::best_compression :
+                                  settings.compression == "default"          ? Flags::default_compression :
+                                                                               Flags::best_speed;
     // Rank 0 creates the folder and the history; every rank learns whether that worked,
     // so that a bad Output/Directory stops all ranks with one message instead of a hang.
     std::string problem;

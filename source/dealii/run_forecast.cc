@@ -20,7 +20,7 @@ namespace mpm
     }
   } // namespace
 
-  void print_run_forecast(std::ostream &out, const Parameters &p, MPI_Comm communicator)
+  void print_run_forecast(std::ostream &out, const Parameters &p, MPI_Comm communicator, const bool prefailure_stage)
   {
     check_memory(p, communicator);
     const unsigned int n_ranks = dealii::Utilities::MPI::n_mpi_processes(communicator);
@@ -28,7 +28,7 @@ namespace mpm
       return;
     const MemoryEstimate e     = estimate_memory(p, -1, n_ranks);
     const FirstStep      first = first_time_step(p);
-    const bool from_fem = p.initial_state_source != "prm bodies" || p.prefailure.analysis != fem::Analysis::none;
+    const bool from_fem = p.initial_state.source != "prm bodies" || prefailure_stage;
 
     out << "dealii-mpm: the scene passed the checks made before a run generates its points; nothing was run or "
            "written.\n";
@@ -39,7 +39,7 @@ namespace mpm
         << number(e.n_nodes, 10) << " nodes), " << p.dim << "D\n";
     if (from_fem) // the points are those of the FEM state (its quadrature points or a lattice)
       out << "  material points: those of "
-          << (p.prefailure.analysis != fem::Analysis::none ? "the pre-failure analysis" : "Initial state/FEM file")
+          << (prefailure_stage ? "the pre-failure analysis" : "Initial state/FEM file")
           << ", not counted here (the memory below counts the bodies' instead)\n";
     else
       out << "  material points: about " << number(std::round(e.n_points), 10) << " in " << p.bodies.size()
@@ -70,11 +70,11 @@ namespace mpm
             << (p.max_steps > 0 && first.steps >= p.max_steps ? ", Solver/Maximum number of steps" : "") << "\n";
       }
     out << "  outputs: " << number(predicted_outputs(p), 10);
-    if (p.output_interval > 0)
-      out << " (every " << number(p.output_interval) << " s, the initial state included)";
+    if (p.output.interval > 0)
+      out << " (every " << number(p.output.interval) << " s, the initial state included)";
     else
       out << " (the initial and final states)";
-    out << " into '" << p.output_directory << "'\n";
+    out << " into '" << p.output.directory << "'\n";
     const double GB = 1e9;
     out << "  memory: about " << number(e.total(n_ranks) / GB, 3) << " GB in all";
     if (n_ranks > 1)
@@ -85,7 +85,7 @@ namespace mpm
     if (e.per_rank_grid_bytes > 0)
       out << ", the coarse grid and the block tables " << number(e.per_rank_grid_bytes / GB, 3) << " GB";
     out << "; doc/guards.md, \"The memory estimate\")\n";
-    out << "  backend: " << p.backend << " in " << (p.single_precision ? "float" : "double") << ", " << n_ranks
+    out << "  backend: " << p.backend.name << " in " << (p.backend.single_precision ? "float" : "double") << ", " << n_ranks
         << " rank(s)" << std::endl;
   }
 } // namespace mpm

@@ -223,12 +223,12 @@ namespace mpm
                 body.points.initial_domain_half_length[d][i] *= scale;
               }
       }
-    check_backend(parameters.backend); // before any set-up
+    check_backend(parameters.backend.name); // before any set-up
 
     // Set-up. The CUDA context is created on a thread of its own (0.3-0.5 s on the GPU
     // host) and the bodies' points on another (they need the lattice only).
     std::future<void> cuda_ready;
-    if (parameters.backend == "cuda")
+    if (parameters.backend.name == "cuda")
       cuda_ready = start_cuda_initialisation(s.communicator);
     std::shared_future<std::vector<GeneratedBody<dim>>> generation;
     if (given_bodies != nullptr)
@@ -240,7 +240,7 @@ namespace mpm
     else
       generation =
         std::async(std::launch::async, [&parameters]() { return generate_bodies<dim>(parameters); }).share();
-    s.output = std::make_unique<OutputWriter<dim>>(parameters, s.communicator); // MPI: before the grid thread
+    s.output = std::make_unique<OutputWriter<dim>>(parameters.output, parameters.backend.name == "cuda", s.communicator); // MPI: before the grid thread
     // Before plasticity start time every model behaves elastically.
     s.materials = parameters.materials;
     s.plastic   = !(parameters.plasticity_start_time > 0);
@@ -251,11 +251,11 @@ namespace mpm
     auto count_points = [&]() {
       for (const GeneratedBody<dim> &body : generation.get())
         {
-          s.n_points_initial += body.points.size();
+          s.losses.n_points_initial += body.points.size();
           for (const double m : body.points.mass)
             {
-              s.m_min = std::min(s.m_min, m);
-              s.initial_mass += m;
+              s.losses.m_min = std::min(s.losses.m_min, m);
+              s.losses.initial_mass += m;
             }
           // The first adaptive time step heeds the bodies' initial velocity (after a step
           // the step's own largest speed does).
@@ -267,7 +267,7 @@ namespace mpm
               s.max_speed = std::max(s.max_speed, std::sqrt(v2));
             }
         }
-      AssertThrow(s.n_points_initial > 0,
+      AssertThrow(s.losses.n_points_initial > 0,
                   dealii::ExcMessage("Parameter 'Material points': the bodies contain no material point (each "
                                      "body must cover at least one point site of the grid)."));
       s.c_el = elastic_wave_speed(generation.get(), parameters, given_bodies == nullptr);
@@ -312,10 +312,10 @@ namespace mpm
         labels->state_variable_names = parameters.state_variable_names();
         if (cuda_ready.valid())
           cuda_ready.get();
-        s.engine = make_engine<dim>(parameters.backend, lattice_grid<dim>(parameters, parameters.active_block_cells == 0), s.materials,
+        s.engine = make_engine<dim>(parameters.backend.name, lattice_grid<dim>(parameters, parameters.active_block_cells == 0), s.materials,
                                     parameters.shape_function, parameters.active_block_cells,
-                                    parameters.single_precision);
-        s.engine->set_sort_interval(parameters.sort_interval);
+                                    parameters.backend.single_precision);
+        s.engine->set_sort_interval(parameters.backend.sort_interval);
         s.engine->load(host, std::move(labels));
         s.engine_setup_seconds =
           std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -343,9 +343,9 @@ namespace mpm
         s.balance();
         if (cuda_ready.valid())
           cuda_ready.get();
-        s.engine = make_engine<dim>(parameters.backend, *s.grid, s.materials, parameters.shape_function,
-                                    parameters.single_precision, parameters.active_block_cells);
-        s.engine->set_sort_interval(parameters.sort_interval);
+        s.engine = make_engine<dim>(parameters.backend.name, *s.grid, s.materials, parameters.shape_function,
+                                    parameters.backend.single_precision, parameters.active_block_cells);
+        s.engine->set_sort_interval(parameters.backend.sort_interval);
         s.engine->load(*s.points);
         s.timer.leave_subsection();
       }
@@ -354,10 +354,10 @@ namespace mpm
     s.print_header();
     s.apply_settings();
 
-    if (parameters.equilibrate)
+    if (parameters.initial_state.equilibrate)
       s.equilibrate();
 
-    s.next_output          = parameters.output_interval;
+    s.next_output          = parameters.output.interval;
     s.last_progress        = std::chrono::steady_clock::now();
     s.last_checkpoint_wall = s.last_progress;
     s.set_up               = true;
@@ -423,33 +423,33 @@ namespace mpm
     s.time += dt;
     ++s.step;
 
-    if (s.step % parameters.history_every == 0)
+    if (s.step % parameters.output.history_every == 0)
       s.record_history();
-    if (parameters.output_interval > 0 && s.time >= s.next_output * (1 - 1e-12))
+    if (parameters.output.interval > 0 && s.time >= s.next_output * (1 - 1e-12))
       {
         s.write_output();
         const double due = s.time * (1 + 1e-12);
         // An interval below the step (the step is at least 1e-12 End time) would take this loop
         // an interval at a time up to now: 1e296 turns for 1e-300 s, and for one below the
         // round-off of the time it never ends. Jump past now instead.
-        if (s.next_output + parameters.output_interval <= due)
+        if (s.next_output + parameters.output.interval <= due)
           s.next_output =
-            std::max(due + parameters.output_interval, std::nextafter(due, std::numeric_limits<double>::infinity()));
+            std::max(due + parameters.output.interval, std::nextafter(due, std::numeric_limits<double>::infinity()));
         while (s.next_output <= due)
-          s.next_output += parameters.output_interval;
+          s.next_output += parameters.output.interval;
       }
 
     // Checkpoints: every Step interval steps, and where a rank asks (wall clock, a stop).
     if (!s.parallel)
       s.request = s.local_request();
-    if ((parameters.checkpoint_step_interval > 0 && s.step % parameters.checkpoint_step_interval == 0) ||
+    if ((parameters.checkpoint.step_interval > 0 && s.step % parameters.checkpoint.step_interval == 0) ||
         s.request > 0)
       s.write_checkpoint();
     s.stopped = s.request == 2;
 
     const auto now = std::chrono::steady_clock::now();
-    if (parameters.progress_interval > 0 &&
-        std::chrono::duration<double>(now - s.last_progress).count() >= parameters.progress_interval)
+    if (parameters.output.progress_interval > 0 &&
+        std::chrono::duration<double>(now - s.last_progress).count() >= parameters.output.progress_interval)
       {
         const KeepPrecision keep(std::cout);
         const double        elapsed = std::chrono::duration<double>(now - s.wall_start).count();
@@ -483,12 +483,12 @@ namespace mpm
                 << std::endl;
         return;
       }
-    if (s.step % parameters.history_every != 0)
+    if (s.step % parameters.output.history_every != 0)
       s.record_history();
     const double end = parameters.end_time;
     // Not again where the last output was at this time (End time = 0 included: one output at t = 0).
-    if (!(parameters.output_interval > 0 && std::abs(s.time - (s.next_output - parameters.output_interval)) <=
-                                              1e-12 * std::max(end, parameters.output_interval)))
+    if (!(parameters.output.interval > 0 && std::abs(s.time - (s.next_output - parameters.output.interval)) <=
+                                              1e-12 * std::max(end, parameters.output.interval)))
       s.write_output();
     // The handler is not brought up to date at the end: nothing reads it after the run
     // (the last output and the totals come from the engine). That hand-over cost 2.2 s of
@@ -498,12 +498,12 @@ namespace mpm
       dealii::TimerOutput::Scope scope(s.timer, "output: waiting for the last files");
       s.output->finish(); // the last files are complete
     }
-    if (parameters.checkpoint_at_end && s.last_checkpoint_step != s.step)
+    if (parameters.checkpoint.at_end && s.last_checkpoint_step != s.step)
       s.write_checkpoint();
 
     const KeepPrecision keep(std::cout);
     const double wall  = std::chrono::duration<double>(std::chrono::steady_clock::now() - s.wall_start).count();
-    const double n_now = static_cast<double>(s.n_points_initial - s.n_removed);
+    const double n_now = static_cast<double>(s.losses.n_points_initial - s.n_removed);
     const long   steps = s.step - s.first_step; // by this process
     const double stepping =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - s.stepping_start).count();
@@ -512,17 +512,17 @@ namespace mpm
             << " material point(s) left the grid and were removed.\n"
             << "  set-up " << wall - stepping << " s, then " << stepping << " s of steps and output ("
             << (n_now * steps) / stepping << " point-updates/s)\n"
-            << "  loss checks: " << s.n_points_initial - s.n_removed << " points in the grid + " << s.n_removed
-            << " removed = " << s.n_points_initial << " initial; mass in the grid + removed = initial mass to "
-            << s.worst_mass_balance << " (largest relative difference over the history rows)\n";
+            << "  loss checks: " << s.losses.n_points_initial - s.n_removed << " points in the grid + " << s.n_removed
+            << " removed = " << s.losses.n_points_initial << " initial; mass in the grid + removed = initial mass to "
+            << s.losses.worst_mass_balance << " (largest relative difference over the history rows)\n";
     if (s.engine->follows_material() && s.parallel)
       s.pcout << "  nodes near the material: " << s.engine->n_active_nodes() << " at the end, "
               << s.engine->most_nodes() << " at most (summed over the ranks); chosen again "
               << std::max(0L, s.engine->node_choices() - 1) << " times (at every re-sort and repartition)\n";
     else if (s.engine->follows_material())
       s.pcout << "  nodes near the material: " << s.engine->n_active_nodes() << " at the end, "
-              << s.engine->most_nodes() << " at most; chosen again " << s.n_node_refreshes
-              << " times; the points' distances from the cells they were in checked in " << s.n_home_checks
+              << s.engine->most_nodes() << " at most; chosen again " << s.migration.n_node_refreshes
+              << " times; the points' distances from the cells they were in checked in " << s.migration.n_home_checks
               << " of " << steps << " steps\n";
     if (s.parallel && s.grid->coarse_away_from_material())
       s.pcout << "  deal.II's grid: fine only near the material, " << s.grid->triangulation.n_global_active_cells()
@@ -533,17 +533,17 @@ namespace mpm
               << " choices (the others through the block table)\n";
     if (s.parallel)
       {
-        s.pcout << "  MPI: " << s.n_resorts << " re-sorts of the points into cells and ranks, "
+        s.pcout << "  MPI: " << s.migration.n_resorts << " re-sorts of the points into cells and ranks, "
                 << static_cast<long>(sum(double(s.points->n_sent), s.communicator)) << " points migrated, "
-                << s.n_repartitions << " repartitions; work per rank max/mean " << s.imbalance() << "\n"
-                << "  MPI: the points' distances from their home cells checked in " << s.n_home_checks << " of "
+                << s.migration.n_repartitions << " repartitions; work per rank max/mean " << s.imbalance() << "\n"
+                << "  MPI: the points' distances from their home cells checked in " << s.migration.n_home_checks << " of "
                 << steps << " steps (in the others a bound from the largest speed showed no point could be more than "
-                << s.resort_at << " cells out)\n";
+                << s.migration.resort_at << " cells out)\n";
         // Ghost exchange per step: import + export of every ghost node's value, for each
         // array the scheme sums (MUSL: mass, momentum, force, then momentum again).
         const double ghosts = s.grid->partitioner->n_ghost_indices();
         const int    arrays = parameters.scheme == UpdateScheme::musl ? 3 * dim + 1 : 2 * dim + 1;
-        const double bytes  = sum(double(s.grid->exchange_bytes_per_array(parameters.single_precision ? sizeof(float) :
+        const double bytes  = sum(double(s.grid->exchange_bytes_per_array(parameters.backend.single_precision ? sizeof(float) :
                                                                                                   sizeof(double))),
                                  s.communicator) *
                              arrays;
@@ -582,18 +582,18 @@ namespace mpm
       }
     s.pcout << "  output: " << s.output->n_outputs() << " outputs, " << s.output->task_seconds()
             << " s building and writing files on rank 0";
-    if (parameters.output_in_background)
+    if (parameters.output.in_background)
       s.pcout << " (background threads; the run waited " << s.output->waited_seconds() << " s for them)";
     s.pcout << "\n";
     // Only the files this run wrote (Output/Write particles, Write grid fields, Write particle table).
     const std::string where   = s.output->directory() + "/";
     const bool        outputs = s.output->n_outputs() > 0;
     s.pcout << "  results: ";
-    if (outputs && parameters.write_particles)
+    if (outputs && parameters.output.write_particles)
       s.pcout << where << "particles.pvd, ";
-    if (outputs && parameters.write_grid_fields)
+    if (outputs && parameters.output.write_grid_fields)
       s.pcout << where << "grid.pvd, ";
-    if (outputs && parameters.write_particle_table)
+    if (outputs && parameters.output.write_particle_table)
       s.pcout << where << "particle_table_NNNNN.R.csv (one per output and rank), ";
     s.pcout << where << "history.csv" << std::endl;
     // Files an earlier run left here would be found by a glob or a file dialog beside this
@@ -649,7 +649,7 @@ namespace mpm
       Simulator<dim> simulator(parameters, communicator);
       if (!resume_from.empty())
         simulator.resume(resume_from);
-      else if (parameters.initial_state_source == "FEM file")
+      else if (parameters.initial_state.source == "FEM file")
         simulator.setup(load_fem_state_points<dim>(parameters, communicator));
       else
         {

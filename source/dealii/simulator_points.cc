@@ -48,7 +48,7 @@ namespace mpm
     // initial mass), and on several ranks those marked as having left the grid are dropped.
     const auto rebase_initial_mass = [&]() {
       const PointTotals<dim, double> t = s.engine->totals();
-      s.initial_mass = s.global_sum(t.mass + t.removed_mass + s.dropped_mass);
+      s.losses.initial_mass = s.global_sum(t.mass + t.removed_mass + s.losses.dropped_mass);
     };
     if (!s.parallel)
       {
@@ -58,8 +58,8 @@ namespace mpm
     for (int i = 0; i < new_points.size(); ++i)
       if (new_points.material[i] < 0)
         {
-          ++s.n_dropped;
-          s.dropped_mass += new_points.mass[i];
+          ++s.losses.n_dropped;
+          s.losses.dropped_mass += new_points.mass[i];
         }
     // Points may have been moved any distance: every rank gets all of them (as setup()
     // gets handed-over points) and keeps those in its cells, ids and labels kept.
@@ -106,7 +106,7 @@ namespace mpm
     s.points->replace(all);
     s.refine_near_material();
     s.engine->load(*s.points);
-    ++s.n_resorts;
+    ++s.migration.n_resorts;
     if (s.balance())
       s.engine->load(*s.points);
     rebase_initial_mass();

@@ -4,17 +4,18 @@
 #include <mpm/dealii/checkpoint.h>
 #include <mpm/dealii/fem_handover.h>
 #include <mpm/dealii/simulator.h>
-#include <mpm/fem/continuation.h>
 #include <mpm/fem/prefailure_analysis.h>
+#include <mpm/run/prefailure_then_mpm.h>
 
 #include <deal.II/base/conditional_ostream.h>
 #include <deal.II/base/mpi.h>
 
 #include <iostream>
 
-namespace mpm::fem
+namespace mpm
 {
   using namespace dealii;
+  using namespace fem;
 
   namespace
   {
@@ -43,15 +44,16 @@ namespace mpm::fem
 
     // The MPM stage continued from its checkpoint: the analysis is not run again.
     template <int dim>
-    bool resume(const Parameters &parameters, const MPI_Comm communicator, const std::string &resume_from,
+    bool resume(const Scene &scene, const MPI_Comm communicator, const std::string &resume_from,
                 const std::function<void()> &before_mpm)
     {
-      AssertThrow(parameters.prefailure.continue_with_mpm,
+      const Parameters &parameters = scene.mpm;
+      AssertThrow(scene.prefailure.continue_with_mpm,
                   ExcMessage("--resume: Pre-failure analysis/Continue with MPM is false, so this scene has no MPM "
                              "stage and no checkpoints to resume."));
       const RunState checkpoint_state = checkpoint::read_state(checkpoint::find(resume_from));
       // 'failing factor' is the analysis's result, known only from the checkpoint; a number must match it.
-      const PrefailureParameters &p = parameters.prefailure;
+      const PrefailureParameters &p = scene.prefailure;
       AssertThrow(p.mpm_strength_from_failure || p.mpm_strength_factor == checkpoint_state.strength_divisor,
                   ExcMessage("Parameter 'Pre-failure analysis/MPM strength factor': it is " +
                              std::to_string(p.mpm_strength_factor) + ", but the checkpoint given to --resume was "
@@ -68,12 +70,12 @@ namespace mpm::fem
     }
 
     template <int dim>
-    bool run(const Parameters &parameters, const MPI_Comm communicator, const std::function<void()> &before_mpm)
+    bool run(const Scene &scene, const MPI_Comm communicator, const std::function<void()> &before_mpm)
     {
       ConditionalOStream          pcout(std::cout, Utilities::MPI::this_mpi_process(communicator) == 0);
-      PrefailureAnalysis<dim>     analysis(parameters, communicator);
+      PrefailureAnalysis<dim>     analysis(prefailure_scene(scene), communicator);
       const PrefailureResult      result = analysis.run();
-      const PrefailureParameters &p      = parameters.prefailure;
+      const PrefailureParameters &p      = scene.prefailure;
       if (!p.continue_with_mpm)
         return true;
 
@@ -86,7 +88,7 @@ namespace mpm::fem
                                  "number."));
           factor = result.failing_factor;
         }
-      const Parameters mpm = with_strength_divided(parameters, factor);
+      const Parameters mpm = with_strength_divided(scene.mpm, factor);
 
       std::map<types::material_id, HandoverMaterial> handover;
       for (const auto &[id, m] : analysis.materials())
@@ -107,13 +109,12 @@ namespace mpm::fem
     }
   } // namespace
 
-  bool run_prefailure_analysis(const Parameters &parameters, const MPI_Comm communicator,
-                               const std::string &resume_from, const std::function<void()> &before_mpm)
+  bool run_prefailure_analysis(const Scene &scene, const MPI_Comm communicator, const std::string &resume_from,
+                               const std::function<void()> &before_mpm)
   {
     if (!resume_from.empty())
-      return parameters.dim == 2 ? resume<2>(parameters, communicator, resume_from, before_mpm) :
-                                   resume<3>(parameters, communicator, resume_from, before_mpm);
-    return parameters.dim == 2 ? run<2>(parameters, communicator, before_mpm) :
-                                 run<3>(parameters, communicator, before_mpm);
+      return scene.mpm.dim == 2 ? resume<2>(scene, communicator, resume_from, before_mpm) :
+                                  resume<3>(scene, communicator, resume_from, before_mpm);
+    return scene.mpm.dim == 2 ? run<2>(scene, communicator, before_mpm) : run<3>(scene, communicator, before_mpm);
   }
-} // namespace mpm::fem
+} // namespace mpm

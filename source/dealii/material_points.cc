@@ -89,7 +89,7 @@ namespace mpm
     , grid(grid)
   {
     // The cell weights of the load balance: cell_partition_weight (background_grid.h).
-    const double point_weight = parameters.point_weight;
+    const double point_weight = parameters.parallel.point_weight;
     this->point_weight        = (cell_partition_weight(1, point_weight) - cell_partition_weight(0, point_weight)) / 16.;
     empty_cells_weigh         = empty_cells_cost(parameters);
     using CellStatus                 = typename dealii::Triangulation<dim>::CellStatus;

@@ -1,5 +1,5 @@
 // The state of a Simulator between its steps, and what its source files share
-// (source/simulator*.cc, source/instability_message.cc). Private to the library.
+// (source/dealii/simulator*.cc, instability_message.cc). Private to the library.
 #ifndef MPM_SOURCE_SIMULATOR_STATE_H
 #define MPM_SOURCE_SIMULATOR_STATE_H
 
@@ -155,33 +155,40 @@ namespace mpm
     bool                                    plastic = false;
     StepSettings<dim, double>               settings;
 
-    long   n_points_initial = 0;
-    double m_min            = 1e300;
-    // The loss checks (check_losses): the initial mass, and on this rank the points dropped
-    // from the engine after leaving the grid (re-sorts), their number and mass; the largest
-    // relative mass balance seen.
-    double initial_mass = 0, dropped_mass = 0, worst_mass_balance = 0;
-    long   n_dropped    = 0;
+    // The loss checks (check_losses): the points and the mass the run started with, the
+    // smallest point mass, and on this rank the points dropped from the engine after leaving
+    // the grid (re-sorts), their number and mass; the largest relative mass balance seen.
+    struct Losses
+    {
+      long   n_points_initial = 0;
+      double m_min            = 1e300;
+      double initial_mass = 0, dropped_mass = 0, worst_mass_balance = 0;
+      long   n_dropped    = 0;
+    } losses;
     // One rank: deal.II's grid and handler being built on a thread (see setup()).
     std::future<GridAndPoints> grid_build;
     const std::string          beside_grid          = "setup and first steps, beside deal.II's grid";
     double                     engine_setup_seconds = 0;
     bool                       initial_output_pending = false;
 
-    double resort_at = 1e300; // re-sort (or choose the nodes again) once a point is farther out than this
-    // Several ranks: a bound on the distance of any point outside its home cell (cells): the
-    // largest distance at the last check (0 after a re-sort) plus step_displacement_bound of
-    // every step since; the points are checked only once it exceeds resort_at (n_home_checks
-    // counts those checks). Unknown until the first check: a resumed run's points may sit
-    // outside the cells they were saved in.
-    double drift_bound = std::numeric_limits<double>::infinity();
-    long   n_home_checks = 0;
-    // MPM_VERIFY_DRIFT_BOUND=1 (tests): check the points every step and stop where one is
-    // farther out than the bound says.
-    const bool verify_drift_bound = std::getenv("MPM_VERIFY_DRIFT_BOUND") != nullptr;
-    long   n_resorts = 0, n_repartitions = 0;
-    long   n_node_refreshes = 0; // one rank, nodes near the material: how often they were chosen again
-    double balanced  = 1; // imbalance right after the last repartition: what p4est achieves
+    // Where the points are among the cells and ranks (simulator_migration.cc).
+    struct Migration
+    {
+      double resort_at = 1e300; // re-sort (or choose the nodes again) once a point is farther out than this
+      // Several ranks: a bound on the distance of any point outside its home cell (cells): the
+      // largest distance at the last check (0 after a re-sort) plus step_displacement_bound of
+      // every step since; the points are checked only once it exceeds resort_at (n_home_checks
+      // counts those checks). Unknown until the first check: a resumed run's points may sit
+      // outside the cells they were saved in.
+      double drift_bound   = std::numeric_limits<double>::infinity();
+      long   n_home_checks = 0;
+      // MPM_VERIFY_DRIFT_BOUND=1 (tests): check the points every step and stop where one is
+      // farther out than the bound says.
+      const bool verify_drift_bound = std::getenv("MPM_VERIFY_DRIFT_BOUND") != nullptr;
+      long       n_resorts = 0, n_repartitions = 0;
+      long       n_node_refreshes = 0; // one rank, nodes near the material: how often they were chosen again
+      double     balanced         = 1; // imbalance right after the last repartition: what p4est achieves
+    } migration;
 
     double time = 0, max_speed = 0, max_removed_speed = 0, work_of_gravity = 0, dt = 0, gravity_power = 0;
     bool                equilibrating = false;
@@ -211,7 +218,7 @@ namespace mpm
         return 2;
       const double minutes =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - last_checkpoint_wall).count() / 60;
-      return parameters.checkpoint_wall_interval > 0 && minutes >= parameters.checkpoint_wall_interval ? 1 : 0;
+      return parameters.checkpoint.wall_interval > 0 && minutes >= parameters.checkpoint.wall_interval ? 1 : 0;
     }
 
     // Reductions over the ranks; on one rank the value itself, without an MPI call.
@@ -252,34 +259,13 @@ namespace mpm
     }
 
     // Max/mean work per rank; the engine knows its points where it re-sorts them itself.
-    double imbalance() const
-    {
-      return engine ? points->imbalance(static_cast<double>(engine->n_points())) : points->imbalance();
-    }
+    double imbalance() const;
 
     // Repartition when the work per rank is out of balance by more than the threshold and
     // by clearly more than the last repartition could reach (no futile repeats when the
     // granularity of cells forbids better). Points per rank only change at re-sorts, so
     // this is checked at the start and after each re-sort.
-    bool balance()
-    {
-      if (!parallel || !(parameters.load_balance_threshold > 0))
-        return false;
-      const double before = imbalance();
-      if (before <= parameters.load_balance_threshold ||
-          before <= balanced + 0.5 * (parameters.load_balance_threshold - 1))
-        return false;
-      dealii::TimerOutput::Scope scope(timer, "repartition");
-      output->finish(); // a grid output in flight reads the DoFHandler
-      if (engine)
-        engine->sync(*points); // the handler's points move with their cells
-      points->repartition();
-      ++n_repartitions;
-      balanced = points->imbalance();
-      pcout << "  repartitioned the grid by work: max/mean work per rank " << before << " -> " << balanced
-            << std::endl;
-      return true;
-    }
+    bool balance();
 
     // Plastic models answer elastically until Solver/Plasticity start time.
     void switch_plasticity_on_when_due()
@@ -331,7 +317,7 @@ namespace mpm
     // (settle()), so that the GPU never waits for the host between steps.
     bool queue_steps() const
     {
-      return parameters.queue_steps && !parallel && !equilibrating && engine->queues_steps() &&
+      return parameters.backend.queue_steps && !parallel && !equilibrating && engine->queues_steps() &&
              !engine->follows_material();
     }
     // The step queued last and not yet collected: the time step the host's rule gave it, the
@@ -349,7 +335,7 @@ namespace mpm
       rule.wave_speed       = c_el;
       rule.fixed_step       = parameters.fixed_time_step;
       rule.end_time         = parameters.end_time;
-      rule.lands_on_outputs = parameters.output_interval > 0;
+      rule.lands_on_outputs = parameters.output.interval > 0;
       rule.shortest_landing = 1e-12 * parameters.end_time;
       return rule;
     }
@@ -413,7 +399,7 @@ namespace mpm
                                          " cells outside the cell it was sorted into, beyond the ghost cells "
                                          "whose pressure sums are exchanged between ranks. Reduce 'Solver/CFL "
                                          "number' or the time step."));
-          if (distance > resort_at)
+          if (distance > migration.resort_at)
             {
               bool refined;
               {
@@ -439,11 +425,11 @@ namespace mpm
                                          "chosen, beyond the kept cells whose pressure sums the step used (Grid/"
                                          "Active block size = " + std::to_string(parameters.active_block_cells) +
                                          "). Reduce 'Solver/CFL number' or the time step, or enlarge the blocks."));
-          if (distance > resort_at)
+          if (distance > migration.resort_at)
             {
               engine->refresh_active_nodes();
-              ++n_node_refreshes;
-              drift_bound = 0; // every point is in its home cell now
+              ++migration.n_node_refreshes;
+              migration.drift_bound = 0; // every point is in its home cell now
               loop_times.resorts += std::chrono::duration<double>(clock::now() - checked).count();
             }
         }
@@ -460,122 +446,7 @@ namespace mpm
 
     // Initial state/Equilibrate: damped steps at t = 0 with gravity in full until the points
     // rest in the MPM's own equilibrium of the state given (time and step stay 0).
-    void equilibrate()
-    {
-      const auto started = std::chrono::steady_clock::now();
-      switch_plasticity_on_when_due(); // the materials as the first step will have them
-      for (int d = 0; d < dim; ++d)
-        settings.gravity[d] = parameters.gravity[d];
-
-      PointSnapshot<dim> before;
-      engine->snapshot(before);
-      const HostPoints<dim, double> &p0 = before.points;
-      // The reference speed sqrt(|g| H), H the extent of the points' domains along gravity.
-      double g = 0;
-      for (int d = 0; d < dim; ++d)
-        g += parameters.gravity[d] * parameters.gravity[d];
-      g = std::sqrt(g);
-      double lowest = 1e300, highest = -1e300, smallest_domain = h;
-      for (int i = 0; i < p0.size(); ++i)
-        if (p0.material[i] >= 0)
-          for (int d = 0; d < dim; ++d)
-            smallest_domain = std::min(smallest_domain, p0.domain_half_length[d][i]);
-      for (int i = 0; i < p0.size(); ++i)
-        if (p0.material[i] >= 0 && g > 0)
-          {
-            double along = 0, reach = 0;
-            for (int d = 0; d < dim; ++d)
-              {
-                along += p0.position[d][i] * parameters.gravity[d] / g;
-                reach += p0.domain_half_length[d][i] * std::abs(parameters.gravity[d]) / g;
-              }
-            lowest  = std::min(lowest, along - reach);
-            highest = std::max(highest, along + reach);
-          }
-      const double extent = g > 0 ? global_max(highest) + global_max(-lowest) : 0;
-      equilibration.reference_speed = g > 0 ? std::sqrt(g * extent) : c_el;
-      const double transit = (g > 0 ? extent : h) / c_el;
-
-      // Damped, PIC (FLIP would keep velocities the grid does not see, undamped for ever), and
-      // the points held in place: the equilibrium of the geometry given, not of one the points
-      // creep into (at a free surface a point whose domain just reaches a node's support feels
-      // that light node's large acceleration, and drifts).
-      //
-      // With GIMP the grid keeps its velocities between the steps (a dynamic relaxation on
-      // the grid); rebuilt from the points, the light nodes at a free surface relax over
-      // thousands of steps and leave forces that FLIP then turns into creeping point
-      // velocities (doc/log.md). A light node whose points reach it with the tail of a
-      // domain of half-length l has a stiffness over mass of up to c^2 sum_d 1/(l_d h),
-      // so the step is cut to a Courant number of sqrt(l_min / (dim h)) (at most the
-      // run's): omega dt <= 1 for the stiffest such node. Linear shape functions give no
-      // such bound (a point close to a node line makes the node's ratio unbounded): there
-      // the velocities are rebuilt from the points, which is stable, and slower.
-      const bool   on_grid = parameters.shape_function == ShapeFunction::gimp;
-      const double courant = on_grid ? std::sqrt(global_min(smallest_domain) / (dim * h)) : 1e300;
-      const double damping = settings.damping, flip_fraction = settings.flip_fraction;
-      settings.damping       = parameters.equilibration_damping;
-      settings.flip_fraction = 0;
-      settings.hold_points   = true;
-      equilibrating          = true;
-      double calm            = 0; // how long the points have been at rest
-      while (calm < transit)
-        {
-          AssertThrow(equilibration.steps < long(parameters.equilibration_maximum_steps),
-                      dealii::ExcMessage(
-                        "Parameter 'Initial state/Equilibration maximum steps': after " +
-                        std::to_string(equilibration.steps) + " damped steps the largest point speed is still " +
-                        dealii::Utilities::to_string(max_speed / equilibration.reference_speed) +
-                        " sqrt(|g| H), above 'Initial state/Equilibration tolerance' (" +
-                        dealii::Utilities::to_string(parameters.equilibration_tolerance) +
-                        "). Either the state is not stable under these materials (it fails under its own "
-                        "weight), or it needs more steps: raise the maximum or the tolerance."));
-          const double dt = parameters.adaptive_time_step ?
-                              std::min(parameters.cfl, courant) * h / (c_el + max_speed) :
-                              std::min(parameters.fixed_time_step, courant * h / c_el);
-          settings.hold_from_point_momentum = !on_grid || equilibration.steps == 0;
-          engine_step(dt);
-          ++equilibration.steps;
-          calm = max_speed < parameters.equilibration_tolerance * equilibration.reference_speed ? calm + dt : 0;
-        }
-      equilibrating             = false;
-      settings.damping          = damping;
-      settings.flip_fraction    = flip_fraction;
-      settings.hold_points      = false;
-      equilibration.final_speed = max_speed;
-
-      // How far it moved the stresses, point by point (by id: the engine may reorder them).
-      PointSnapshot<dim> after;
-      engine->snapshot(after);
-      std::unordered_map<dealii::types::particle_index, int> index;
-      for (int i = 0; i < p0.size(); ++i)
-        if (p0.material[i] >= 0)
-          index[before.labels->id[i]] = i;
-      const HostPoints<dim, double> &p1 = after.points;
-      double largest = 0, squares = 0, compared = 0;
-      for (int i = 0; i < p1.size(); ++i)
-        {
-          const auto found = index.find(after.labels->id[i]);
-          if (p1.material[i] < 0 || found == index.end())
-            continue;
-          const int j = found->second;
-          double change = 0;
-          for (int c = 0; c < n_voigt; ++c)
-            change = std::max(change, std::abs(p1.stress[c][i] - p0.stress[c][j]));
-          largest = std::max(largest, change);
-          squares += change * change;
-          compared += 1;
-        }
-      equilibration.max_stress_change = global_max(largest);
-      equilibration.rms_stress_change = std::sqrt(global_sum(squares) / std::max(1.0, global_sum(compared)));
-      equilibration.wall_seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-      pcout << "  equilibration: " << equilibration.steps << " damped steps (D = "
-            << parameters.equilibration_damping << ") in " << equilibration.wall_seconds
-            << " s; largest point speed at rest " << equilibration.final_speed << " m/s ("
-            << equilibration.final_speed / equilibration.reference_speed
-            << " sqrt(|g| H)); the stresses changed by up to " << equilibration.max_stress_change << " Pa (r.m.s. "
-            << equilibration.rms_stress_change << " Pa)" << std::endl;
-    }
+    void equilibrate();
 
     // The step's settings from the prm (gravity is set by each step, from the ramp).
     void apply_settings()
@@ -594,179 +465,42 @@ namespace mpm
       settings.disconnected_points =
         std::any_of(parameters.materials.begin(), parameters.materials.end(),
                     [](const MaterialParameters<double> &m) { return m.disconnection_volume_ratio > 0; });
-      settings.mass_tolerance     = 1e-12 * m_min; // nodes lighter than that carry no velocity
+      settings.mass_tolerance     = 1e-12 * losses.m_min; // nodes lighter than that carry no velocity
       settings.wall_faces         = 0;
       for (unsigned int id = 0; id < 2 * dim; ++id)
         if (parameters.boundary[id] != BoundaryType::free)
           settings.wall_faces |= std::uint8_t(1u << id);
     }
 
-    void print_header()
-    {
-      const HostGrid<dim, double> lattice = lattice_geometry<dim>(parameters);
-      long                        n_cells = 1, n_nodes = 1;
-      for (int d = 0; d < dim; ++d)
-        {
-          n_cells *= lattice.n_cells[d];
-          n_nodes *= lattice.n_cells[d] + 1;
-        }
-      pcout << "dealii-mpm: " << dim << "D, " << n_cells << " cells, " << n_nodes << " nodes, " << n_points_initial
-            << " material points, " << n_ranks << " MPI rank(s), backend " << parameters.backend
-            << (parameters.single_precision ? " in float" : "") << "\n"
-            << "  elastic wave speed " << c_el << " m/s, end time " << parameters.end_time << " s, output in '"
-            << output->directory() << "'" << std::endl;
-      if (parameters.cells_per_grid_cell > 1)
-        pcout << "  deal.II's grid: " << n_cells / dealii::Utilities::pow(parameters.cells_per_grid_cell, dim)
-              << " cells of " << parameters.cells_per_grid_cell << "^" << dim << " (Grid/Cells per deal.II cell)"
-              << std::endl;
-      if (engine->follows_material() && parallel)
-        pcout << "  nodes near the material: " << engine->n_active_nodes() << " of the " << n_nodes
-              << " (blocks of " << parameters.active_block_cells << " cells; summed over the ranks, a node on each "
-              << "rank that holds it), chosen again at every re-sort; deal.II's grid fine only near the "
-                 "material"
-              << std::endl;
-      else if (engine->follows_material())
-        pcout << "  nodes near the material: " << engine->n_active_nodes() << " of the " << n_nodes
-              << " (blocks of " << parameters.active_block_cells << " cells), chosen again once a point is more than "
-              << resort_at << " cells out of the cell it was in" << std::endl;
-      else if (parallel && parameters.active_block_cells > 0)
-        pcout << "  Grid/Nodes = near material with Backend = cuda is for one rank so far: each rank keeps every "
-                 "node of its part of the grid"
-              << std::endl;
-    }
+    void print_header();
 
     // Everything of the run but its points and grid, for a checkpoint (collective: the
     // points handed between ranks are summed).
-    RunState run_state() const
-    {
-      RunState r;
-      r.dim                  = dim;
-      r.n_ranks              = n_ranks;
-      r.lower                = parameters.lower;
-      r.upper                = parameters.upper;
-      r.cell_size            = parameters.cell_size;
-      r.n_materials          = parameters.materials.size();
-      r.state_variable_names = parameters.state_variable_names();
-      r.strength_divisor     = parameters.strength_divisor;
-      r.time                 = time;
-      r.dt                   = dt;
-      r.max_speed            = max_speed;
-      r.max_removed_speed    = max_removed_speed;
-      r.work_of_gravity      = work_of_gravity;
-      r.elastic_wave_speed   = c_el;
-      r.smallest_point_mass  = m_min;
-      r.balanced             = balanced;
-      r.next_output          = next_output;
-      r.step                 = step;
-      r.n_points_initial     = n_points_initial;
-      r.n_removed            = n_removed;
-      r.initial_mass         = initial_mass;
-      r.n_dropped            = parallel ? static_cast<long>(sum(double(n_dropped), communicator)) : n_dropped;
-      r.dropped_mass         = parallel ? sum(dropped_mass, communicator) : dropped_mass;
-      r.n_resorts            = n_resorts;
-      r.n_repartitions       = n_repartitions;
-      r.n_sent               = parallel ? static_cast<long>(sum(double(points->n_sent), communicator)) : 0;
-      r.plastic              = plastic;
-      r.equilibration        = equilibration;
-      const auto records     = output->records();
-      r.n_outputs            = records.n_outputs;
-      r.grid_records         = records.grid;
-      r.particle_records     = records.particles;
-      return r;
-    }
+    RunState run_state() const;
 
     // Several ranks near the material: deal.II's grid refined where the points are about to
     // need it (MaterialPoints::refine_near_points); whether it was (collective).
-    bool refine_near_material()
-    {
-      if (!parallel || !grid->coarse_away_from_material())
-        return false;
-      return points->refine_near_points([&]() {
-        if (output)
-          output->finish(); // a grid output in flight reads the DoFHandler
-      });
-    }
+    bool refine_near_material();
 
     // Several ranks: the partition of the grid by the points' work as it is now (where the
     // run repartitions at all). A pure function of the points' cells, whichever partition the
     // grid had before: a run resumed on an even partition comes to the same one.
-    void partition_by_current_work()
-    {
-      if (!parallel || !(parameters.load_balance_threshold > 0))
-        return;
-      output->finish(); // a grid output in flight reads the DoFHandler
-      points->repartition();
-      ++n_repartitions;
-      balanced = points->imbalance();
-    }
+    void partition_by_current_work();
 
     // A checkpoint of the run after the current step. Then the engine starts anew from the
     // saved points exactly as a run resumed from the checkpoint does (on several ranks: the
     // handler filled with them, the grid partitioned by their work, the engine loaded from
     // the handler; on one: the engine loaded with them, forgetting what it built for the
     // points before, the CPU's scatter slabs): the resumed run is bit-identical to this one.
-    std::string write_checkpoint()
-    {
-      settle();
-      join_grid();
-      dealii::TimerOutput::Scope scope(timer, "checkpoint");
-      const auto                 started = std::chrono::steady_clock::now();
-      PointSnapshot<dim>         snapshot;
-      if (parallel)
-        {
-          resort(); // every point on the rank owning its cell
-        }
-      engine->snapshot(snapshot);
-      last_checkpoint = checkpoint::write<dim>(parameters.checkpoint_directory, run_state(), snapshot,
-                                               parameters.checkpoint_keep, communicator);
-      start_from(snapshot);
-      last_checkpoint_wall = std::chrono::steady_clock::now();
-      last_checkpoint_step = step;
-      pcout << "  checkpoint at t = " << time << " s (step " << step << "): " << last_checkpoint << " ("
-            << std::chrono::duration<double>(last_checkpoint_wall - started).count() << " s)" << std::endl;
-      return last_checkpoint;
-    }
+    std::string write_checkpoint();
 
     // The engine (made where there is none yet) starts from `saved`: a checkpoint's points,
     // all of this rank's (one rank) or those in its cells (several).
-    void start_from(const PointSnapshot<dim> &saved)
-    {
-      if (parallel)
-        {
-          points->replace(saved);
-          refine_near_material();
-          partition_by_current_work();
-          if (!engine)
-            engine = make_engine<dim>(parameters.backend, *grid, materials, parameters.shape_function,
-                                      parameters.single_precision, parameters.active_block_cells);
-          engine->load(*points);
-        }
-      else
-        {
-          if (!engine)
-            engine = make_engine<dim>(parameters.backend, lattice_grid<dim>(parameters, parameters.active_block_cells == 0), materials,
-                                      parameters.shape_function, parameters.active_block_cells,
-                                      parameters.single_precision);
-          engine->load(saved.points, saved.labels); // in the saved order: the same sums as before
-        }
-      engine->set_sort_interval(parameters.sort_interval);
-    }
+    void start_from(const PointSnapshot<dim> &saved);
 
     // The MPI re-sort, counting the points it drops (those that left the grid): they must be
     // the ones the engine held as removed.
-    void resort()
-    {
-      const PointTotals<dim, double> held    = engine->totals();
-      const unsigned int             dropped = engine->resort(*points);
-      AssertThrow(static_cast<long>(dropped) == held.n_removed,
-                  dealii::ExcMessage("Internal error (loss check): a re-sort dropped " + std::to_string(dropped) +
-                                     " points, but " + std::to_string(held.n_removed) +
-                                     " had left the grid on this rank."));
-      n_dropped += held.n_removed;
-      dropped_mass += held.removed_mass;
-      ++n_resorts;
-      drift_bound = 0; // every point is in its home cell now
-    }
+    void resort();
 
     // How far a point can be outside the cell it was sorted into (several ranks) or was in
     // when the engine chose its nodes (one rank, nodes near the material): the largest
@@ -777,20 +511,20 @@ namespace mpm
     template <typename When>
     double distance_outside_home_cells(const double dt, const When &when)
     {
-      drift_bound += step_displacement_bound(dt);
-      double     distance = drift_bound;
-      const bool needed   = !(drift_bound <= resort_at);
-      if (needed || verify_drift_bound)
+      migration.drift_bound += step_displacement_bound(dt);
+      double     distance = migration.drift_bound;
+      const bool needed   = !(migration.drift_bound <= migration.resort_at);
+      if (needed || migration.verify_drift_bound)
         {
           distance = global_max(engine->max_distance_outside_home_cells());
-          n_home_checks += needed;
-          AssertThrow(needed || distance <= drift_bound,
+          migration.n_home_checks += needed;
+          AssertThrow(needed || distance <= migration.drift_bound,
                       dealii::ExcMessage("Internal error (MPM_VERIFY_DRIFT_BOUND): a point is " +
                                          dealii::Utilities::to_string(distance) +
                                          " cells outside its home cell, beyond the bound " +
-                                         dealii::Utilities::to_string(drift_bound) + " " + when()));
+                                         dealii::Utilities::to_string(migration.drift_bound) + " " + when()));
           if (needed)
-            drift_bound = distance;
+            migration.drift_bound = distance;
         }
       return distance;
     }
@@ -807,21 +541,7 @@ namespace mpm
     // less than one cell outside its home cell. Re-sorting at half a cell (GIMP's safe
     // distance already) leaves a step's displacement of room; the check after each step
     // asserts it.
-    void set_resort_distance()
-    {
-      // One rank, nodes near the material: every cell within Active block size cells of a
-      // point's home cell is kept. The pressure averaging sums over the cells the points
-      // have moved to within the step (less than a cell, CFL <= 1): choosing the nodes again
-      // once a point is B - 1 cells out keeps those cells' sums.
-      if (!parallel)
-        resort_at = !engine->follows_material() ? 1e300 :
-                    parameters.pressure_averaging ?
-                                                  std::min(engine->active_node_margin(), parameters.active_block_cells - 1.0) :
-                                                  engine->active_node_margin();
-      else
-        resort_at = std::min(parameters.resort_distance * safe_distance_outside_home_cell(parameters.shape_function),
-                             parameters.pressure_averaging ? 0.5 : 1e300);
-    }
+    void set_resort_distance();
 
     // A bound on how far (in cells, max-norm) any point moved in the step of length dt just
     // taken, from the largest speeds over the ranks; infinite where none is known. MUSL moves
@@ -831,92 +551,20 @@ namespace mpm
     // weights are non-negative and sum to at most 1, so a point moves at most dt times that.
     // Wall contact and fixed components only shrink nodal velocities. APIC's remap adds
     // C_p (x_i - x_p) and USL/USF move the points with v_i + dt a_i: no such bound.
-    double step_displacement_bound(const double dt) const
-    {
-      if (parameters.scheme != UpdateScheme::musl || settings.affine_state_variable >= 0)
-        return std::numeric_limits<double>::infinity();
-      return dt * std::max(max_speed, max_removed_speed) / h * (1 + 1e-9); // 1e-9: the sums' round-off
-    }
+    double step_displacement_bound(const double dt) const;
 
     // Points are never made or lost but by leaving the grid: the points in the grid and those
     // removed make the initial number exactly, and their masses the initial mass to round-off
     // (Engine::relative_mass_round_off: 1e-9 in double, the sums' order differs; 1e-7 in float,
     // each mass rounded once). Throws where either fails: a bug, not a bad input.
     // Returns (removed mass, relative mass balance).
-    std::pair<double, double> check_losses(const PointTotals<dim, double> &totals)
-    {
-      double       local[2] = {double(n_dropped), dropped_mass}, global[2] = {local[0], local[1]};
-      if (parallel)
-        dealii::Utilities::MPI::sum(dealii::ArrayView<const double>(local, 2), communicator,
-                                    dealii::ArrayView<double>(global, 2));
-      const long   removed      = totals.n_removed + static_cast<long>(global[0]);
-      const double removed_mass = totals.removed_mass + global[1];
-      const double balance      = (totals.mass + removed_mass - initial_mass) / initial_mass;
-      n_removed                 = removed;
-      worst_mass_balance        = std::max(worst_mass_balance, std::abs(balance));
-      const std::string when    = " at t = " + dealii::Utilities::to_string(time) + " s (step " + std::to_string(step) + ")";
-      AssertThrow(totals.n_points + removed == n_points_initial,
-                  dealii::ExcMessage("Internal error (loss check)" + when + ": " + std::to_string(totals.n_points) +
-                                     " material points in the grid and " + std::to_string(removed) +
-                                     " removed make " + std::to_string(totals.n_points + removed) + ", not the " +
-                                     std::to_string(n_points_initial) + " the run started with."));
-      const double round_off = engine->relative_mass_round_off();
-      AssertThrow(std::abs(balance) <= round_off,
-                  dealii::ExcMessage("Internal error (loss check)" + when + ": the mass in the grid (" +
-                                     dealii::Utilities::to_string(totals.mass) + " kg) and the mass removed (" +
-                                     dealii::Utilities::to_string(removed_mass) + " kg) differ from the initial " +
-                                     dealii::Utilities::to_string(initial_mass) + " kg by a relative " +
-                                     dealii::Utilities::to_string(balance) + ", beyond round-off (" +
-                                     dealii::Utilities::to_string(round_off) + ")."));
-      return {removed_mass, balance};
-    }
+    std::pair<double, double> check_losses(const PointTotals<dim, double> &totals);
 
-    void record_history()
-    {
-      settle();
-      timed("history", [&]() {
-        const auto local  = engine->totals();
-        const auto totals = parallel ? global_totals<dim>(local, communicator) : local;
-        const auto [removed_mass, balance] = check_losses(totals);
-        typename OutputWriter<dim>::HistoryRow row{time, dt, work_of_gravity, step, n_removed, totals};
-        row.removed_mass = removed_mass;
-        row.mass_balance = balance;
-        row.min_points_per_rank = static_cast<long>(global_min(double(local.n_points)));
-        row.max_points_per_rank = static_cast<long>(global_max(double(local.n_points)));
-        row.n_resorts           = n_resorts;
-        row.n_repartitions      = n_repartitions;
-        row.n_sent              = parallel ? static_cast<long>(sum(double(points->n_sent), communicator)) : 0;
-        output->write_history(row);
-      });
-    }
+    void record_history();
 
     // Output reads a snapshot of the engine's points: no hand-over to the handler, which
     // is brought up to date only where it is needed (re-sorts, repartitions).
-    void write_output()
-    {
-      settle();
-      if (time == 0 && grid_build.valid())
-        {
-          engine->snapshot(output->next_snapshot());
-          initial_output_pending = true;
-          return;
-        }
-      join_grid();
-      dealii::TimerOutput::Scope scope(timer, "output");
-      PointSnapshot<dim> &snapshot = output->next_snapshot();
-      // The nodes first: their download waits for the device, the points' does not (the
-      // CUDA engine's come down while the next steps are queued; the particle task waits).
-      if (!grid) // one rank, nodes near the material: the grid files show the engine's cells
-        {
-          typename GridSnapshot<dim>::LatticeCells cells;
-          engine->cells_with_mass(cells);
-          engine->start_snapshot(snapshot);
-          return output->write_fields(time, std::move(cells));
-        }
-      engine->nodal_to(*grid);
-      engine->start_snapshot(snapshot);
-      output->write_fields(time, *grid);
-    }
+    void write_output();
   };
 } // namespace mpm
 

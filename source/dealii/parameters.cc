@@ -138,7 +138,7 @@ namespace mpm
       for (const std::string &field : PropertyLayout<dim>::fields(p.state_variable_names()))
         if (std::find(allowed.begin(), allowed.end(), field) == allowed.end())
           allowed.push_back(field);
-      for (const std::string &given : p.particle_fields)
+      for (const std::string &given : p.output.particle_fields)
         if (given == "all")
           fail("Output/Particle fields", "'all' stands alone; it cannot be combined with other fields.");
         else if (given != "id" && given != "position" &&
@@ -422,155 +422,23 @@ namespace mpm
     prm.leave_subsection();
 
     prm.enter_subsection("Output");
-    prm.declare_entry("Directory", "output", Patterns::DirectoryName(),
-                      "Folder for .vtu/.pvtu/.pvd files and the time history; created if missing. Files of an earlier "
-                      "run there that this run does not overwrite are kept, and the run warns of them at its end.");
-    prm.declare_entry("Output interval", "0.1", Patterns::Double(0),
-                      "Simulated time between field outputs (s); 0 = only the initial and final states.");
-    prm.declare_entry("Write grid fields", "true", Patterns::Bool(),
-                      "Write nodal mass and velocity of the background grid with each output.");
-    prm.declare_entry("Write particles", "true", Patterns::Bool(),
-                      "Write every material point with all its properties with each output.");
-    prm.declare_entry("History every n steps", "10", Patterns::Integer(1),
-                      "Steps between rows of the time history (history.csv).");
-    prm.declare_entry("Progress interval", "2", Patterns::Double(0),
-                      "Wall-clock seconds between progress lines on the screen; 0 = none.");
-    prm.declare_entry("Write particle table", "false", Patterns::Bool(),
-                      "Also write particle_table_NNNNN.R.csv (one per output and rank R): id, position and every "
-                      "property in full precision, for comparisons the single-precision .vtu files cannot resolve.");
-    prm.declare_entry("Particle fields", "all", Patterns::List(Patterns::Anything()),
-                      "The point fields written to the particle .vtu files: all, or a comma-separated list of "
-                      "mass, volume, initial_volume, velocity, stress, strain, F, domain_half_length, "
-                      "initial_domain_half_length, plastic_strain, material_id, initial_position, material_field "
-                      "and the state variables of the run's material models. The id and the position are always "
-                      "written. A 3D point carries 39 values with all; fewer fields write smaller files faster. "
-                      "The particle table (Write particle table) keeps every field.");
-    prm.declare_entry("Compression", "best speed",
-                      Patterns::Selection("best speed|default|best compression|no compression"),
-                      "zlib compression level of the .vtu files (deal.II's VtkFlags::compression_level). best "
-                      "speed: about as small as the others for MPM data, several times faster to write than "
-                      "best compression (doc/performance.md, Output).");
-    prm.declare_entry("Write in background", "true", Patterns::Bool(),
-                      "Build, compress and write the output files on a background thread while the steps go on; "
-                      "the points are copied first (one snapshot), so the steps cannot change what is written. With "
-                      "Backend = cuda on Linux these threads run at a lower priority (nice 10), so that they do not "
-                      "take the core of the thread that queues the steps. false: the run waits for each output to "
-                      "be written.");
-    prm.declare_entry("Files per rank", "1", Patterns::Integer(1, 256),
-                      "Each rank writes its grid cells and its points as this many .vtu pieces per output (the "
-                      ".pvtu record lists them all), built, compressed and written on as many threads: more than "
-                      "1 speeds up the output of large scenes on many cores.");
-    prm.declare_entry("Maximum number of outputs", "10000", Patterns::Integer(0),
-                      "Warn (and run on) where Output interval and Solver/End time give more outputs than this "
-                      "(each one .vtu files per rank and a .pvtu record for the grid and the points); 0 = no "
-                      "warning.");
+    OutputSettings::declare(prm);
     prm.leave_subsection();
 
     prm.enter_subsection("Checkpoint");
-    prm.declare_entry("Step interval", "0", Patterns::Integer(0),
-                      "Steps between checkpoints (the whole state of the run, from which --resume continues it "
-                      "exactly); 0 = none by step count.");
-    prm.declare_entry("Wall-clock interval", "0", Patterns::Double(0),
-                      "Wall-clock minutes between checkpoints; 0 = none by wall-clock time. On several ranks the "
-                      "rank whose clock is first due decides for all.");
-    prm.declare_entry("Number kept", "2", Patterns::Integer(1),
-                      "Newest checkpoints kept in the folder; older ones are deleted once a newer one is complete.");
-    prm.declare_entry("Directory", "", Patterns::DirectoryName(),
-                      "Folder of the checkpoints (one sub-folder checkpoint-NNNNNNNNN per checkpoint, NNNNNNNNN its "
-                      "step); empty = the folder 'checkpoints' in Output/Directory.");
-    prm.declare_entry("At end", "false", Patterns::Bool(),
-                      "Also write a checkpoint when the run ends, so that it can be continued to a later End time "
-                      "(dealii-mpm scene.prm --resume FOLDER with the End time raised).");
+    CheckpointSettings::declare(prm);
     prm.leave_subsection();
 
     prm.enter_subsection("Parallel");
-    prm.declare_entry("Re-sort distance", "1", Patterns::Double(0, 1),
-                      "MPI runs: the points are re-sorted into cells and ranks (migrating to the rank owning their "
-                      "new cell) as soon as one point is this fraction of the safe distance outside the cell it was "
-                      "sorted into (the safe distance, half a cell for GIMP and one cell for linear shape functions, "
-                      "keeps its stencil within the rank's nodes). 1 = only when needed, 0 = every step. With "
-                      "Solver/Pressure averaging, at most half a cell (the cell sums cover the ghost cells).");
-    prm.declare_entry("Load balance threshold", "1.1", Patterns::Double(0),
-                      "MPI runs: the grid is repartitioned by work (cells weighted by their points) when the largest "
-                      "work of one rank exceeds this multiple of the mean; checked at the start and after each "
-                      "re-sort. 0 = never repartition; otherwise at least 1.");
-    prm.declare_entry("Point weight", "20", Patterns::Double(0),
-                      "MPI runs: work of one material point relative to one empty grid cell, for the weighted "
-                      "partition (a cell weighs 1 + Point weight x its points; with Grid/Nodes = near material "
-                      "and Backend = cpu a cell without points weighs nothing, since the step does not visit "
-                      "its nodes).");
+    ParallelSettings::declare(prm);
     prm.leave_subsection();
 
     prm.enter_subsection("Initial state");
-    prm.declare_entry("Source", "prm bodies", Patterns::Selection("prm bodies|FEM file"),
-                      "prm bodies: the points of Material points/Body i (with their Initial stress: none or "
-                      "geostatic). FEM file: the state an FEM program saved with mpm::save_fem_state (displacement, "
-                      "quadrature-point stresses and plastic strain), handed over as Placement says; the bodies "
-                      "of Material points are then not used.");
-    prm.declare_entry("FEM file", "", Patterns::Anything(),
-                      "Source = FEM file: the file written by mpm::save_fem_state (a path, relative to the "
-                      "working directory).");
-    prm.declare_entry("Placement", "quadrature points", Patterns::Selection("quadrature points|lattice"),
-                      "quadrature points: one material point per quadrature point of the FEM, volume its JxW "
-                      "(placement (a)). lattice: Points per cell direction^dim points per MPM cell inside the "
-                      "deformed body, stresses projected from the quadrature points (placement (b)).");
-    prm.declare_entry("Points per cell direction", "2", Patterns::Integer(1, 20),
-                      "Placement = lattice: points per MPM cell along each direction.");
-    prm.declare_entry("Projection degree", "-1", Patterns::Integer(-1, 10),
-                      "Placement = lattice: polynomial degree of the cell-wise L2 projection of the quadrature-point "
-                      "state (FE_DGQ); -1 = the FEM's displacement degree. Needs degree + 1 quadrature points per "
-                      "direction.");
-    prm.declare_entry("Materials", "", Patterns::Anything(),
-                      "Source = FEM file, or Pre-failure analysis/Mesh = mesh file: 'id: name, density; ...' for every "
-                      "material_id of the FEM mesh: the MPM "
-                      "material (one of Materials/Names) and the density in kg/m^3 (> 0), e.g. '0: soil, 2000; 1: "
-                      "rock, 2400'.");
-    prm.declare_entry("Equilibrate", "false", Patterns::Bool(),
-                      "true: before t = 0 (time stands still), damped steps with gravity in full and the points "
-                      "held in place, only their stresses following the grid, until the grid is at rest: the "
-                      "stresses then balance gravity in the MPM's own discretisation, and an undamped run starts "
-                      "in equilibrium. A state in equilibrium in an FEM is not exactly in equilibrium on the MPM "
-                      "grid (other shape functions, point quadrature), nor is a geostatic stress under a slope. "
-                      "The run reports how much the stresses changed.");
-    prm.declare_entry("Equilibration damping", "0.8", Patterns::Double(0, 1),
-                      "Equilibrate: the local damping coefficient of the damped steps (Solver/Local damping's "
-                      "form), 0 < D < 1.");
-    prm.declare_entry("Equilibration tolerance", "1e-6", Patterns::Double(0),
-                      "Equilibrate: at rest once the largest point speed has stayed below this multiple of "
-                      "sqrt(|g| H) for one elastic wave transit of H (H: the bodies' extent along gravity; "
-                      "without gravity the elastic wave speed replaces sqrt(|g| H)).");
-    prm.declare_entry("Equilibration maximum steps", "100000", Patterns::Integer(1),
-                      "Equilibrate: a state that is not at rest after this many damped steps stops the run "
-                      "(a body that fails under its own weight never comes to rest).");
+    InitialStateSettings::declare(prm);
     prm.leave_subsection();
 
-    fem::PrefailureParameters::declare(prm, dim);
-
     prm.enter_subsection("Backend");
-    prm.declare_entry("Backend", "cpu", Patterns::Selection("cpu|cuda"),
-                      "Where the MPM step runs: cpu (threads through TBB) or cuda (needs a build with "
-                      "-DMPM_WITH_CUDA=ON and a CUDA device on every rank; on several MPI ranks one GPU per "
-                      "rank, chosen by the rank's place on its node, ranks beyond a node's GPUs sharing them).");
-    prm.declare_entry("Sort interval", "20", Patterns::Integer(0),
-                      "cuda: the device re-sorts its points by stencil every this many steps (0: never), so "
-                      "that neighbouring threads add into the same nodes and sum before their atomics. 20 "
-                      "measured faster than 50 and than every step on P1; 10, 20 and 40 alike on P2 "
-                      "(doc/performance.md).");
-    prm.declare_entry("Queue steps", "true", Patterns::Bool(),
-                      "cuda on one MPI rank: queue each step on the GPU before the last one has ended, its time "
-                      "step computed on the device from the last step's largest speed by the same rule as the "
-                      "host's, so that the GPU does not wait for the host between steps (the same steps and time "
-                      "steps, checked to the bit), and the steps between two re-sorts launched as one CUDA graph "
-                      "each. On an H200 P2's step 2% shorter, V3 2D's 14% (doc/performance.md). false: the host "
-                      "waits for each step's speed before it starts the next. Not with Grid/Nodes = near "
-                      "material, whose check after each step needs the points where they are.");
-    prm.declare_entry("Precision", "double", Patterns::Selection("double|float"),
-                      "The floating-point type of the points, the nodes and the step: double, or float (the engine's "
-                      "point and node arrays in half the bytes; with Backend = cuda P2's step 1.46x faster, on the CPU "
-                      "no faster: doc/performance.md; the results carry float's round-off, about 1e-7 of each value per "
-                      "operation, doc/methods.md). float runs with the library's materials, on any number of MPI ranks "
-                      "with either backend (the ranks exchange their nodal sums in float). Output, checkpoints and "
-                      "the time history are written in double either way.");
+    BackendSettings::declare(prm);
     prm.leave_subsection();
 
     prm.enter_subsection("Resources");
@@ -806,70 +674,15 @@ namespace mpm
         material_models.push_back(model);
       }
 
-    prefailure.parse(prm, dim);
-    const bool fem_mesh_file = prefailure.analysis != fem::Analysis::none && prefailure.mesh == "mesh file";
-
     prm.enter_subsection("Initial state");
-    initial_state_source     = prm.get("Source");
-    fem_file                 = prm.get("FEM file");
-    fem_placement            = prm.get("Placement");
-    fem_points_per_direction = prm.get_integer("Points per cell direction");
-    fem_projection_degree    = prm.get_integer("Projection degree");
-    equilibrate                 = prm.get_bool("Equilibrate");
-    equilibration_damping       = prm.get_double("Equilibration damping");
-    equilibration_tolerance     = prm.get_double("Equilibration tolerance");
-    equilibration_maximum_steps = prm.get_integer("Equilibration maximum steps");
-    if (equilibrate && !(equilibration_damping > 0 && equilibration_damping < 1))
-      fail("Initial state/Equilibration damping", "must lie between 0 and 1 (exclusive) where Equilibrate = true.");
-    if (equilibrate && !(equilibration_tolerance > 0))
-      fail("Initial state/Equilibration tolerance", "must be > 0 where Equilibrate = true.");
-    if (equilibrate && gravity_ramp_time > 0)
+    initial_state.parse(prm, material_names, materials);
+    prm.leave_subsection();
+    if (initial_state.equilibrate && gravity_ramp_time > 0)
       fail("Initial state/Equilibrate", "the equilibration holds gravity in full; it needs Solver/Gravity ramp "
                                         "time = 0 (a ramp after it would take the load off the state).");
-    if (initial_state_source == "FEM file" && prefailure.analysis != fem::Analysis::none)
-      fail("Initial state/Source", "the FEM file and a Pre-failure analysis are two initial states; choose one "
-                                   "(Source = prm bodies, or Pre-failure analysis/Method = none).");
-    if (initial_state_source == "FEM file" && fem_file.empty())
-      fail("Initial state/FEM file", "Source = FEM file needs the file's name.");
-    if (initial_state_source == "FEM file" || fem_mesh_file)
-      {
-        for (const std::string &item : dealii::Utilities::split_string_list(prm.get("Materials"), ';'))
-          {
-            const std::string where = "Initial state/Materials";
-            const auto        colon = item.find(':');
-            const std::vector<std::string> rest =
-              colon == std::string::npos ? std::vector<std::string>() :
-                                           dealii::Utilities::split_string_list(item.substr(colon + 1), ',');
-            if (rest.size() != 2)
-              fail(where, "'" + item + "' is not of the form 'id: material name, density'.");
-            int    id      = -1;
-            double density = 0;
-            try
-              {
-                id      = dealii::Utilities::string_to_int(dealii::Utilities::trim(item.substr(0, colon)));
-                density = dealii::Utilities::string_to_double(rest[1]);
-              }
-            catch (...)
-              {
-                fail(where, "'" + item + "' is not of the form 'id: material name, density'.");
-              }
-            const auto name = std::find(material_names.begin(), material_names.end(), rest[0]);
-            if (id < 0 || id > 255 || !(density > 0) || name == material_names.end() || fem_materials.count(id))
-              fail(where, "'" + item + "': the id must be a material_id 0..255 given once, the name one of "
-                          "Materials/Names, the density > 0.");
-            if (materials[name - material_names.begin()].field_parameter != FieldParameter::none)
-              fail(where, "material '" + rest[0] + "' has a random field, which the FEM hand-over does not carry.");
-            fem_materials[id] = {static_cast<unsigned int>(name - material_names.begin()), density};
-          }
-        if (fem_materials.empty())
-          fail("Initial state/Materials", std::string(fem_mesh_file ? "Pre-failure analysis/Mesh = mesh file" :
-                                                                      "Source = FEM file") +
-                                            " needs at least one 'id: material name, density'.");
-      }
-    prm.leave_subsection();
 
     prm.enter_subsection("Material points");
-    const unsigned int n_bodies = initial_state_source == "FEM file" ? 0 : prm.get_integer("Number of bodies");
+    const unsigned int n_bodies = initial_state.source == "FEM file" ? 0 : prm.get_integer("Number of bodies");
     // The bodies' bounding box (Method = auto measures the resolution across it).
     std::vector<double> bodies_lo(dim, std::numeric_limits<double>::max()),
       bodies_hi(dim, std::numeric_limits<double>::lowest());
@@ -982,48 +795,21 @@ namespace mpm
     prm.leave_subsection();
 
     prm.enter_subsection("Output");
-    output_directory  = prm.get("Directory");
-    output_interval   = prm.get_double("Output interval");
-    write_grid_fields = prm.get_bool("Write grid fields");
-    write_particles   = prm.get_bool("Write particles");
-    history_every     = prm.get_integer("History every n steps");
-    progress_interval = prm.get_double("Progress interval");
-    write_particle_table = prm.get_bool("Write particle table");
-    particle_fields      = dealii::Utilities::split_string_list(prm.get("Particle fields"));
-    if (particle_fields == std::vector<std::string>{"all"})
-      particle_fields.clear();
-    output_compression   = prm.get("Compression");
-    output_in_background = prm.get_bool("Write in background");
-    output_files_per_rank = prm.get_integer("Files per rank");
-    max_outputs           = prm.get_integer("Maximum number of outputs");
+    output.parse(prm);
     prm.leave_subsection();
 
     prm.enter_subsection("Checkpoint");
-    checkpoint_step_interval = prm.get_integer("Step interval");
-    checkpoint_wall_interval = prm.get_double("Wall-clock interval");
-    checkpoint_keep          = prm.get_integer("Number kept");
-    checkpoint_directory     = prm.get("Directory");
-    checkpoint_at_end        = prm.get_bool("At end");
-    if (checkpoint_directory.empty())
-      checkpoint_directory = (output_directory.empty() ? std::string(".") : output_directory) + "/checkpoints";
+    checkpoint.parse(prm, output.directory);
     prm.leave_subsection();
 
     prm.enter_subsection("Parallel");
-    resort_distance        = prm.get_double("Re-sort distance");
-    load_balance_threshold = prm.get_double("Load balance threshold");
-    point_weight           = prm.get_double("Point weight");
-    if (load_balance_threshold > 0 && load_balance_threshold < 1)
-      fail("Parallel/Load balance threshold", "must be 0 (never repartition) or at least 1, got " +
-                                                 prm.get("Load balance threshold") + ".");
+    parallel.parse(prm);
     prm.leave_subsection();
 
     prm.enter_subsection("Backend");
-    backend          = prm.get("Backend");
-    sort_interval    = prm.get_integer("Sort interval");
-    queue_steps      = prm.get_bool("Queue steps");
-    single_precision = prm.get("Precision") == "float";
+    backend.parse(prm);
     prm.leave_subsection();
-    if (single_precision)
+    if (backend.single_precision)
       {
         for (unsigned int i = 0; i < materials.size(); ++i)
           if (materials[i].model == MaterialModel::user_defined)
@@ -1052,8 +838,8 @@ namespace mpm
                                   dealii::Utilities::MPI::n_mpi_processes(MPI_COMM_WORLD) == 1;
             // the cubic B-spline GIMP's reaches two cells out: one rank, and blocks of 2 cells or more (CPU)
             const bool bspline3_gimp_allowed =
-              one_rank && (active_block_cells == 0 || (active_block_cells >= 2 && backend != "cuda"));
-            choice = choose_method(method_scene, extent / cell_size, method_tolerance, backend == "cuda",
+              one_rank && (active_block_cells == 0 || (active_block_cells >= 2 && backend.name != "cuda"));
+            choice = choose_method(method_scene, extent / cell_size, method_tolerance, backend.name == "cuda",
                                    hencky_allowed, dim, one_rank && active_block_cells == 0, bspline3_gimp_allowed);
           }
         catch (const std::invalid_argument &e)
@@ -1072,7 +858,7 @@ namespace mpm
             material.elastic_law = m.hencky ? ElasticLaw::hencky : ElasticLaw::jaumann_rate;
         method_choice_report = choice.reason;
       }
-    if (backend == "cuda")
+    if (backend.name == "cuda")
       for (unsigned int i = 0; i < materials.size(); ++i)
         {
           if (materials[i].model == MaterialModel::user_defined)
@@ -1208,7 +994,7 @@ namespace mpm
     // material names (everything else skipped), the second declares every entry for them and
     // rejects unknown ones. parse(prm, skip_undefined) reads the input into prm.
     template <typename Parse>
-    Parameters read_in_two_passes(Parse &&parse)
+    Parameters read_in_two_passes(Parse &&parse, const std::vector<ParameterSection> &sections)
     {
       ParameterHandler layout;
       declare_layout(layout);
@@ -1223,6 +1009,8 @@ namespace mpm
 
       ParameterHandler prm;
       Parameters::declare(prm, dim, n_bodies, names);
+      for (const ParameterSection &section : sections)
+        section.declare(prm, dim);
       try
         {
           parse(prm, false);
@@ -1243,11 +1031,13 @@ namespace mpm
         }
       Parameters parameters;
       parameters.parse(prm);
+      for (const ParameterSection &section : sections)
+        section.parse(prm, parameters);
       return parameters;
     }
   } // namespace
 
-  Parameters read_parameters(const std::string &filename)
+  Parameters read_parameters(const std::string &filename, const std::vector<ParameterSection> &sections)
   {
     {
       std::ifstream in(filename);
@@ -1256,26 +1046,29 @@ namespace mpm
     const std::optional<std::set<std::string>> set_entries = check_parameter_file(filename);
     Parameters parameters = read_in_two_passes([&](ParameterHandler &prm, const bool skip_undefined) {
       prm.parse_input(filename, "", skip_undefined, /*assert_mandatory_entries_are_found=*/false);
-    });
+    }, sections);
     if (set_entries)
       check_given_subsections(parameters, *set_entries);
     return parameters;
   }
 
-  Parameters parameters_from_string(const std::string &text)
+  Parameters parameters_from_string(const std::string &text, const std::vector<ParameterSection> &sections)
   {
     const std::set<std::string> set_entries = check_parameter_text(text);
     Parameters parameters = read_in_two_passes([&](ParameterHandler &prm, const bool skip_undefined) {
       prm.parse_input_from_string(text, "", skip_undefined);
-    });
+    }, sections);
     check_given_subsections(parameters, set_entries);
     return parameters;
   }
 
-  void print_parameters(std::ostream &out, const unsigned int dim, const std::string &style)
+  void print_parameters(std::ostream &out, const unsigned int dim, const std::string &style,
+                        const std::vector<ParameterSection> &sections)
   {
     ParameterHandler prm;
     Parameters::declare(prm, dim, 1, {"soil"});
+    for (const ParameterSection &section : sections)
+      section.declare(prm, dim);
     // The listing of a 3D run must read as one: a copy of it runs in the dimension it was printed for.
     prm.set("Dimension", static_cast<long int>(dim));
     const ParameterHandler::OutputStyle s =

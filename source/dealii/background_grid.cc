@@ -192,7 +192,7 @@ namespace mpm
 
   bool empty_cells_cost(const Parameters &parameters)
   {
-    return !(parameters.active_block_cells > 0 && parameters.backend == "cpu");
+    return !(parameters.active_block_cells > 0 && parameters.backend.name == "cpu");
   }
 
   std::vector<long> blocks_of_every_rank(std::vector<long> own, MPI_Comm communicator)
@@ -294,7 +294,7 @@ namespace mpm
     boost::signals2::scoped_connection weights;
     LatticeBox<dim>                    points_box;
     std::vector<unsigned int>          points_in_cell;
-    if (distributed != nullptr && !start_points.empty() && parameters.load_balance_threshold > 0)
+    if (distributed != nullptr && !start_points.empty() && parameters.parallel.load_balance_threshold > 0)
       {
         long cells[dim];
         cell_extent<dim>(n_cells, cells);
@@ -315,7 +315,7 @@ namespace mpm
                 x[d] = points->position[d][i];
               ++points_in_cell[points_box.index(lattice_cell_of(x), cells)];
             }
-        const double       point_weight  = parameters.point_weight;
+        const double       point_weight  = parameters.parallel.point_weight;
         const bool         empty_cost    = empty_cells_cost(parameters);
         const unsigned int lattice_cells = lattice_cells_per_grid_cell;
         using CellIterator        = typename dealii::Triangulation<dim>::cell_iterator;

@@ -57,7 +57,7 @@ namespace mpm
   std::vector<GeneratedBody<dim>> load_fem_state_points(const Parameters &parameters, MPI_Comm communicator)
   {
     const std::string entry = "Initial state/FEM file";
-    const std::string &file = parameters.fem_file;
+    const std::string &file = parameters.initial_state.fem_file;
     FemStateHeader     header;
     FemStateCells      cells;
     {
@@ -157,19 +157,19 @@ namespace mpm
       };
 
     for (const unsigned int id : cells.material_ids)
-      AssertThrow(parameters.fem_materials.count(id),
+      AssertThrow(parameters.initial_state.materials.count(id),
                   ExcMessage("Parameter 'Initial state/Materials': cells of '" + file + "' have material_id " +
                              std::to_string(id) + ", which it does not map to an MPM material ('" +
                              std::to_string(id) + ": name, density')."));
     std::map<dealii::types::material_id, HandoverMaterial> materials;
-    for (const auto &[id, material] : parameters.fem_materials)
+    for (const auto &[id, material] : parameters.initial_state.materials)
       materials[id] = HandoverMaterial{material.first, material.second};
 
     std::vector<GeneratedBody<dim>> bodies(1);
-    if (parameters.fem_placement == "lattice")
+    if (parameters.initial_state.placement == "lattice")
       bodies[0] = points_on_lattice(dof_handler, displacement, quadrature, state, materials,
-                                    lattice_handover<dim>(parameters, parameters.fem_points_per_direction,
-                                                          parameters.fem_projection_degree));
+                                    lattice_handover<dim>(parameters, parameters.initial_state.points_per_direction,
+                                                          parameters.initial_state.projection_degree));
     else
       bodies[0] = points_at_quadrature_points(dof_handler, displacement, quadrature, state, materials);
     return bodies;

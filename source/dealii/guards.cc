@@ -392,7 +392,7 @@ namespace mpm
     // cell's bytes for about four times the cells the bodies fill, as above), and on every rank
     // the coarse grid (cells of 2^L x k lattice cells, BackgroundGrid) and the blocks' marks and
     // table (about 6 bytes a block); the lookups span only a rank's own cells.
-    else if (p.active_block_cells > 0 && p.backend == "cpu")
+    else if (p.active_block_cells > 0 && p.backend.name == "cpu")
       {
         unsigned int levels = 10;
         for (unsigned int d = 0; d < dim; ++d)
@@ -437,7 +437,7 @@ namespace mpm
           v2 += v * v;
         f.v0 = std::max(f.v0, std::sqrt(v2));
       }
-    for (const auto &[id, material_and_density] : p.fem_materials)
+    for (const auto &[id, material_and_density] : p.initial_state.materials)
       wave_speed(material_and_density.first, material_and_density.second,
                  "the density of Initial state/Materials' id " + std::to_string(id));
     if (f.set_by.empty())
@@ -445,10 +445,10 @@ namespace mpm
     f.dt    = p.adaptive_time_step ? p.cfl * p.cell_size / (f.c_el + f.v0) : p.fixed_time_step;
     f.steps = p.end_time / f.dt;
     // An output interval below the step cuts every step to land on an output time (at
-    // least 1e-12 End time, source/simulator.cc): the outputs then set the steps.
-    f.landing = p.output_interval > 0 && p.output_interval < f.dt;
+    // least 1e-12 End time, source/dealii/simulator.cc): the outputs then set the steps.
+    f.landing = p.output.interval > 0 && p.output.interval < f.dt;
     if (f.landing)
-      f.steps = p.end_time / std::max(p.output_interval, 1e-12 * p.end_time);
+      f.steps = p.end_time / std::max(p.output.interval, 1e-12 * p.end_time);
     if (p.max_steps > 0)
       f.steps = std::min(f.steps, double(p.max_steps));
     return f;
@@ -456,9 +456,9 @@ namespace mpm
 
   double predicted_outputs(const Parameters &p)
   {
-    if (!(p.output_interval > 0))
+    if (!(p.output.interval > 0))
       return p.end_time > 0 ? 2 : 1; // the initial and the final state
-    double outputs = std::floor(p.end_time / p.output_interval * (1 + 1e-12)) + 1;
+    double outputs = std::floor(p.end_time / p.output.interval * (1 + 1e-12)) + 1;
     if (p.max_steps > 0)
       outputs = std::min(outputs, p.max_steps + 1.0); // at most one a step
     return outputs;
@@ -471,7 +471,7 @@ namespace mpm
     // The grid: lattice indices are int (the engine's nodes and points, HostGrid), deal.II's
     // cell, DoF and particle indices 32-bit unsigned.
     std::string  cells;
-    unsigned int most_points_per_direction = p.fem_points_per_direction;
+    unsigned int most_points_per_direction = p.initial_state.points_per_direction;
     for (const BodyParameters &body : p.bodies)
       most_points_per_direction = std::max(most_points_per_direction, body.points_per_direction);
     for (unsigned int d = 0; d < dim; ++d)
@@ -508,7 +508,7 @@ namespace mpm
         const bool   landing = first.landing;
         if (landing && !(steps <= p.max_predicted_steps))
           refuse("Output/Output interval",
-                 number(p.output_interval) + " s is below the first time step " + number(dt) +
+                 number(p.output.interval) + " s is below the first time step " + number(dt) +
                    " s, and every step is cut to land on an output time: about " + number(steps) +
                    " steps to Solver/End time = " + number(p.end_time) + " s, more than Solver/Maximum "
                    "predicted steps = " + number(p.max_predicted_steps) + ": the run would not end. Is the "
@@ -530,15 +530,15 @@ namespace mpm
       }
 
     // Warnings: the run goes on.
-    if (p.output_interval > 0 && p.max_outputs > 0 && (p.write_grid_fields || p.write_particles))
+    if (p.output.interval > 0 && p.output.max_outputs > 0 && (p.output.write_grid_fields || p.output.write_particles))
       {
         const double outputs = predicted_outputs(p);
-        if (outputs > p.max_outputs)
+        if (outputs > p.output.max_outputs)
           warn_about_parameter("Output/Output interval",
-                               number(p.output_interval) + " s up to Solver/End time = " + number(p.end_time) +
+                               number(p.output.interval) + " s up to Solver/End time = " + number(p.end_time) +
                                  " s writes " + number(outputs) + " outputs (each .vtu files of the grid and the "
                                  "points on every rank, and a .pvtu record), more than Output/Maximum number of "
-                                 "outputs = " + std::to_string(p.max_outputs) + ". Raise the interval, or the "
+                                 "outputs = " + std::to_string(p.output.max_outputs) + ". Raise the interval, or the "
                                  "maximum if you mean it (0 = no warning).");
       }
     // With pure FLIP, what a fixed node passes back is its old velocity, the mean of its points': the

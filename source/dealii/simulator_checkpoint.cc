@@ -50,34 +50,35 @@ namespace mpm
     const std::string folder = checkpoint::find(path);
     const RunState    r      = checkpoint::read_state(folder);
     check_resumable(r, parameters, folder);
-    check_backend(parameters.backend);
+    check_backend(parameters.backend.name);
     std::future<void> cuda_ready;
-    if (parameters.backend == "cuda")
+    if (parameters.backend.name == "cuda")
       cuda_ready = start_cuda_initialisation(s.communicator);
 
     s.h                 = parameters.cell_size;
     s.c_el              = r.elastic_wave_speed;
-    s.m_min             = r.smallest_point_mass;
+    s.losses.m_min             = r.smallest_point_mass;
     s.time              = r.time;
     s.dt                = r.dt;
     s.max_speed         = r.max_speed;
     s.max_removed_speed = r.max_removed_speed;
     s.work_of_gravity   = r.work_of_gravity;
-    s.balanced          = r.balanced;
+    s.migration.balanced          = r.balanced;
     s.next_output       = r.next_output;
     s.step              = r.step;
-    s.n_points_initial  = r.n_points_initial;
+    s.losses.n_points_initial  = r.n_points_initial;
     s.n_removed         = r.n_removed;
-    s.initial_mass      = r.initial_mass;
-    s.n_resorts         = r.n_resorts;
-    s.n_repartitions    = r.n_repartitions;
+    s.losses.initial_mass      = r.initial_mass;
+    s.migration.n_resorts         = r.n_resorts;
+    s.migration.n_repartitions    = r.n_repartitions;
     s.equilibration     = r.equilibration;
     s.plastic           = r.plastic;
     s.materials         = parameters.materials;
     for (auto &m : s.materials)
       m.plasticity_enabled = s.plastic;
 
-    s.output = std::make_unique<OutputWriter<dim>>(parameters, s.communicator, /*resuming=*/true);
+    s.output = std::make_unique<OutputWriter<dim>>(parameters.output, parameters.backend.name == "cuda", s.communicator,
+                                                  /*resuming=*/true);
     s.output->resume({r.n_outputs, r.grid_records, r.particle_records}, r.step);
 
     // Each rank reads every rank's points (one rank: all, including those that left the grid,
@@ -91,8 +92,8 @@ namespace mpm
           return true;
         if (rank == 0) // left the grid (saved by one rank): dropped here, counted once
           {
-            ++s.n_dropped;
-            s.dropped_mass += p.mass[i];
+            ++s.losses.n_dropped;
+            s.losses.dropped_mass += p.mass[i];
           }
         return false;
       });
@@ -121,8 +122,8 @@ namespace mpm
       }
     if (rank == 0) // the sums over ranks
       {
-        s.n_dropped    += r.n_dropped;
-        s.dropped_mass += r.dropped_mass;
+        s.losses.n_dropped    += r.n_dropped;
+        s.losses.dropped_mass += r.dropped_mass;
       }
     s.timer.leave_subsection();
 
@@ -152,10 +153,102 @@ namespace mpm
     stop_requested.store(true);
   }
 
+  template <int dim>
+  RunState Simulator<dim>::State::run_state() const
+  {
+    RunState r;
+    r.dim                  = dim;
+    r.n_ranks              = n_ranks;
+    r.lower                = parameters.lower;
+    r.upper                = parameters.upper;
+    r.cell_size            = parameters.cell_size;
+    r.n_materials          = parameters.materials.size();
+    r.state_variable_names = parameters.state_variable_names();
+    r.strength_divisor     = parameters.strength_divisor;
+    r.time                 = time;
+    r.dt                   = dt;
+    r.max_speed            = max_speed;
+    r.max_removed_speed    = max_removed_speed;
+    r.work_of_gravity      = work_of_gravity;
+    r.elastic_wave_speed   = c_el;
+    r.smallest_point_mass  = losses.m_min;
+    r.balanced             = migration.balanced;
+    r.next_output          = next_output;
+    r.step                 = step;
+    r.n_points_initial     = losses.n_points_initial;
+    r.n_removed            = n_removed;
+    r.initial_mass         = losses.initial_mass;
+    r.n_dropped            = parallel ? static_cast<long>(sum(double(losses.n_dropped), communicator)) : losses.n_dropped;
+    r.dropped_mass         = parallel ? sum(losses.dropped_mass, communicator) : losses.dropped_mass;
+    r.n_resorts            = migration.n_resorts;
+    r.n_repartitions       = migration.n_repartitions;
+    r.n_sent               = parallel ? static_cast<long>(sum(double(points->n_sent), communicator)) : 0;
+    r.plastic              = plastic;
+    r.equilibration        = equilibration;
+    const auto records     = output->records();
+    r.n_outputs            = records.n_outputs;
+    r.grid_records         = records.grid;
+    r.particle_records     = records.particles;
+    return r;
+  }
+
+  template <int dim>
+  std::string Simulator<dim>::State::write_checkpoint()
+  {
+    settle();
+    join_grid();
+    dealii::TimerOutput::Scope scope(timer, "checkpoint");
+    const auto                 started = std::chrono::steady_clock::now();
+    PointSnapshot<dim>         snapshot;
+    if (parallel)
+      {
+        resort(); // every point on the rank owning its cell
+      }
+    engine->snapshot(snapshot);
+    last_checkpoint = checkpoint::write<dim>(parameters.checkpoint.directory, run_state(), snapshot,
+                                             parameters.checkpoint.keep, communicator);
+    start_from(snapshot);
+    last_checkpoint_wall = std::chrono::steady_clock::now();
+    last_checkpoint_step = step;
+    pcout << "  checkpoint at t = " << time << " s (step " << step << "): " << last_checkpoint << " ("
+          << std::chrono::duration<double>(last_checkpoint_wall - started).count() << " s)" << std::endl;
+    return last_checkpoint;
+  }
+
+  template <int dim>
+  void Simulator<dim>::State::start_from(const PointSnapshot<dim> &saved)
+  {
+    if (parallel)
+      {
+        points->replace(saved);
+        refine_near_material();
+        partition_by_current_work();
+        if (!engine)
+          engine = make_engine<dim>(parameters.backend.name, *grid, materials, parameters.shape_function,
+                                    parameters.backend.single_precision, parameters.active_block_cells);
+        engine->load(*points);
+      }
+    else
+      {
+        if (!engine)
+          engine = make_engine<dim>(parameters.backend.name, lattice_grid<dim>(parameters, parameters.active_block_cells == 0), materials,
+                                    parameters.shape_function, parameters.active_block_cells,
+                                    parameters.backend.single_precision);
+        engine->load(saved.points, saved.labels); // in the saved order: the same sums as before
+      }
+    engine->set_sort_interval(parameters.backend.sort_interval);
+  }
+
   template std::string Simulator<2>::write_checkpoint();
   template bool Simulator<2>::stopped() const;
   template void Simulator<2>::resume(const std::string &);
   template std::string Simulator<3>::write_checkpoint();
   template bool Simulator<3>::stopped() const;
   template void Simulator<3>::resume(const std::string &);
+  template RunState Simulator<2>::State::run_state() const;
+  template RunState Simulator<3>::State::run_state() const;
+  template std::string Simulator<2>::State::write_checkpoint();
+  template std::string Simulator<3>::State::write_checkpoint();
+  template void Simulator<2>::State::start_from(const PointSnapshot<2> &);
+  template void Simulator<3>::State::start_from(const PointSnapshot<3> &);
 } // namespace mpm
