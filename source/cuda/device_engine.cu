@@ -385,6 +385,7 @@ namespace mpm
                       HostPoints<dim, Real> &host, SlotScratch &scratch, const cudaStream_t stream)
       {
         const int m = static_cast<int>(slots.size());
+        host.fields = points.fields;
         host.set_n_state_variables(points.n_state_variables()); // the affine transfers' matrices, if any
         host.resize(m);
         size_t bytes = 0;
@@ -934,6 +935,7 @@ namespace mpm
       impl->finish_pending_averaging();
       const DevicePoints<dim, Real> &points = impl->points;
       const int                      n      = points.size();
+      p.fields = points.fields;
       p.resize(n);
       if (p.n_state_variables() < points.n_state_variables())
         p.set_n_state_variables(points.n_state_variables());

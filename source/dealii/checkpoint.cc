@@ -43,15 +43,18 @@ namespace mpm
     {
       // Marks the files of this format; a file of another kind or version is refused.
       // Format 2 (2026-12-03): the run's strength divisor (a pre-failure hand-over's).
-      constexpr unsigned int format = 0x4d504d02, format_1 = 0x4d504d01; // "MPM" 2, "MPM" 1
+      // Format 3 (2026-12-07): the points' fields by name (point_fields.h), each array after its name.
+      constexpr unsigned int format = 0x4d504d03, format_2 = 0x4d504d02, format_1 = 0x4d504d01; // "MPM" 3, 2, 1
 
       // Refuses a file of another format, naming it.
       void check_format(const unsigned int magic, const std::string &file)
       {
-        AssertThrow(magic != format_1,
-                    dealii::ExcMessage("--resume: '" + file + "' was written by an earlier dealii-mpm (checkpoint "
-                                       "format 1, before 2026-12-03), which this one does not read: resume it "
-                                       "with the version that wrote it."));
+        for (const auto &[old, since] : {std::pair<unsigned int, const char *>{format_1, "2026-12-03"},
+                                         std::pair<unsigned int, const char *>{format_2, "2026-12-07"}})
+          AssertThrow(magic != old,
+                      dealii::ExcMessage("--resume: '" + file + "' was written by an earlier dealii-mpm (checkpoint "
+                                         "format " + std::to_string(old & 0xff) + ", before " + since +
+                                         "), which this one does not read: resume it with the version that wrote it."));
         AssertThrow(magic == format,
                     dealii::ExcMessage("--resume: '" + file + "' is not a dealii-mpm checkpoint file."));
       }
@@ -124,8 +127,18 @@ namespace mpm
           const unsigned int              dimension = dim;
           int                             n = snapshot.points.size(), n_state_variables = snapshot.points.n_state_variables();
           archive << format << dimension << n << n_state_variables << snapshot.labels->state_variable_names;
-          for_each_point_array<dim>(snapshot.points, snapshot.points,
-                                    [&](const auto &array, const auto &) { archive << array; });
+          std::vector<std::string> fields;
+          for_each_core_field(snapshot.points, [&](const PointField field, const auto &) {
+            if (snapshot.points.fields.has(field))
+              fields.push_back(info(field).member);
+          });
+          archive << fields;
+          for_each_core_field(snapshot.points, [&](const PointField field, const auto &member) {
+            if (snapshot.points.fields.has(field))
+              for_each_array_of(member, [&](const auto &array) { archive << array; });
+          });
+          for (const auto &array : snapshot.points.state_variables)
+            archive << array;
           archive << snapshot.labels->id;
           for (int d = 0; d < dim; ++d)
             archive << snapshot.labels->initial_position[d];
@@ -153,10 +166,30 @@ namespace mpm
         archive >> names;
         AssertThrow(dimension == dim, dealii::ExcMessage("--resume: '" + file + "' holds points of a " +
                                                          std::to_string(dimension) + "D run."));
+        // The fields as the file names them, each field's arrays after the list.
+        std::vector<std::string> fields;
+        archive >> fields;
         HostPoints<dim, double> part;
+        std::vector<PointField> order;
+        for (const std::string &name : fields)
+          {
+            int f = 0;
+            while (f < n_point_fields && name != point_field_info[f].member)
+              ++f;
+            AssertThrow(f < n_point_fields, dealii::ExcMessage("--resume: '" + file + "' holds a point field '" + name +
+                                                               "' that this dealii-mpm does not know."));
+            part.fields.insert(static_cast<PointField>(f));
+            order.push_back(static_cast<PointField>(f));
+          }
         part.set_n_state_variables(n_state_variables);
         part.resize(n);
-        for_each_point_array<dim>(part, part, [&](auto &array, auto &) { archive >> array; });
+        for (const PointField wanted : order)
+          for_each_core_field(part, [&](const PointField field, auto &member) {
+            if (field == wanted)
+              for_each_array_of(member, [&](auto &array) { archive >> array; });
+          });
+        for (auto &array : part.state_variables)
+          archive >> array;
         std::vector<dealii::types::particle_index> id;
         std::vector<double>                        initial_position[dim];
         archive >> id;
@@ -164,7 +197,10 @@ namespace mpm
           archive >> initial_position[d];
         labels.state_variable_names = names;
         if (to.size() == 0)
-          to.set_n_state_variables(n_state_variables);
+          {
+            to.fields = part.fields;
+            to.set_n_state_variables(n_state_variables);
+          }
         for (int i = 0; i < n; ++i)
           if (keep(part, i))
             {

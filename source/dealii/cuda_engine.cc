@@ -207,6 +207,7 @@ namespace mpm
         for (const auto &from : incoming)
           n_received += static_cast<int>(from.second.size()) / (n_values + n_labels);
         HostPoints<dim, double> received;
+        received.fields = leaving.fields;
         received.set_n_state_variables(leaving.n_state_variables());
         received.resize(n_received);
         std::vector<std::vector<double>> received_labels(n_labels, std::vector<double>(n_received));

@@ -13,62 +13,133 @@
 
 namespace mpm
 {
-  template <int dim>
-  std::vector<std::string> PropertyLayout<dim>::names(const std::vector<std::string> &state_variable_names)
+  namespace
   {
-    const char *axis[3] = {"x", "y", "z"};
-    const char *voigt[6] = {"xx", "yy", "zz", "xy", "yz", "xz"};
-    std::vector<std::string> n = {"mass", "volume", "initial_volume"};
-    for (int d = 0; d < dim; ++d)
-      n.push_back("velocity");
-    for (const char *c : voigt)
-      n.push_back(std::string("stress_") + c);
-    for (const char *c : voigt)
-      n.push_back(std::string("strain_") + c);
-    for (int a = 0; a < dim; ++a)
-      for (int b = 0; b < dim; ++b)
-        n.push_back(std::string("F_") + axis[a] + axis[b]);
-    for (int d = 0; d < dim; ++d)
-      n.push_back("domain_half_length");
-    for (int d = 0; d < dim; ++d)
-      n.push_back("initial_domain_half_length");
-    n.push_back("plastic_strain");
-    n.push_back("material_id");
-    for (int d = 0; d < dim; ++d)
-      n.push_back("initial_position");
-    n.push_back("material_field");
+    // The components' suffixes of a field of this shape ("" for scalars and vectors).
+    template <int dim>
+    std::vector<std::string> component_suffixes(const FieldShape shape)
+    {
+      const char *axis[3]  = {"x", "y", "z"};
+      const char *voigt[6] = {"xx", "yy", "zz", "xy", "yz", "xz"};
+      std::vector<std::string> s;
+      switch (shape)
+        {
+          case FieldShape::scalar:
+            return {""};
+          case FieldShape::vector:
+            return std::vector<std::string>(dim, "");
+          case FieldShape::voigt:
+            for (const char *c : voigt)
+              s.push_back(std::string("_") + c);
+            return s;
+          case FieldShape::tensor:
+            for (int a = 0; a < dim; ++a)
+              for (int b = 0; b < dim; ++b)
+                s.push_back(std::string("_") + axis[a] + axis[b]);
+            return s;
+        }
+      return s;
+    }
+
+    bool in_handler(const PointField field, const PointFieldSet &carried)
+    {
+      return info(field).place != FieldPlace::core && carried.has(field);
+    }
+  } // namespace
+
+  template <int dim>
+  PropertyLayout<dim>::PropertyLayout(const PointFieldSet &fields, const std::vector<std::string> &state_variable_names)
+    : carried(fields)
+    , state_variable_names(state_variable_names)
+  {
+    unsigned int at = 0;
+    for (int f = 0; f < n_point_fields; ++f)
+      {
+        const PointField field = static_cast<PointField>(f);
+        offsets[f]             = in_handler(field, carried) ? static_cast<int>(at) : -1;
+        if (offsets[f] >= 0)
+          at += field_arrays<dim>(info(field).shape);
+      }
+    first_state_variable = at;
+  }
+
+  template <int dim>
+  unsigned int PropertyLayout<dim>::offset(const PointField field) const
+  {
+    AssertThrow(offsets[static_cast<int>(field)] >= 0,
+                dealii::ExcMessage(std::string("PropertyLayout: the points carry no property '") + info(field).member +
+                                   "'."));
+    return offsets[static_cast<int>(field)];
+  }
+
+  template <int dim>
+  std::vector<std::string> PropertyLayout<dim>::names() const
+  {
+    std::vector<std::string> n;
+    for (int f = 0; f < n_point_fields; ++f)
+      if (offsets[f] >= 0)
+        for (const std::string &suffix : component_suffixes<dim>(point_field_info[f].shape))
+          n.push_back(point_field_info[f].output_name + suffix);
     n.insert(n.end(), state_variable_names.begin(), state_variable_names.end());
     return n;
   }
 
   template <int dim>
-  std::vector<std::string> PropertyLayout<dim>::fields(const std::vector<std::string> &state_variable_names)
+  std::vector<std::string> PropertyLayout<dim>::fields() const
   {
-    std::vector<std::string> f = names(state_variable_names);
-    for (unsigned int c = 0; c < n_voigt; ++c)
-      {
-        f[stress + c] = "stress";
-        f[strain + c] = "strain";
-      }
-    for (unsigned int c = 0; c < dim * dim; ++c)
-      f[deformation_gradient + c] = "F";
-    return f;
+    std::vector<std::string> n;
+    for (int f = 0; f < n_point_fields; ++f)
+      if (offsets[f] >= 0)
+        for (unsigned int c = 0; c < component_suffixes<dim>(point_field_info[f].shape).size(); ++c)
+          n.push_back(point_field_info[f].output_name);
+    n.insert(n.end(), state_variable_names.begin(), state_variable_names.end());
+    return n;
   }
 
   template <int dim>
   std::vector<dealii::DataComponentInterpretation::DataComponentInterpretation>
-  PropertyLayout<dim>::interpretations(const unsigned int n_state_variables)
+  PropertyLayout<dim>::interpretations() const
   {
     using namespace dealii::DataComponentInterpretation;
-    std::vector<DataComponentInterpretation> k(n_properties(n_state_variables), component_is_scalar);
-    for (unsigned int d = 0; d < dim; ++d)
-      {
-        k[velocity + d]                   = component_is_part_of_vector;
-        k[domain_half_length + d]         = component_is_part_of_vector;
-        k[initial_domain_half_length + d] = component_is_part_of_vector;
-        k[initial_position + d]           = component_is_part_of_vector;
-      }
+    std::vector<DataComponentInterpretation> k;
+    for (int f = 0; f < n_point_fields; ++f)
+      if (offsets[f] >= 0)
+        k.insert(k.end(), field_arrays<dim>(point_field_info[f].shape),
+                 point_field_info[f].shape == FieldShape::vector ? component_is_part_of_vector : component_is_scalar);
+    k.insert(k.end(), state_variable_names.size(), component_is_scalar);
     return k;
+  }
+
+  template <int dim>
+  void PropertyLayout<dim>::write(const HostPoints<dim, double> &points, const int i, double *values,
+                                  const bool written_only) const
+  {
+    for_each_core_field(points, [&](const PointField field, const auto &member) {
+      const int at = offsets[static_cast<int>(field)];
+      if (at < 0 || (written_only && !info(field).written_by_step))
+        return;
+      int c = 0;
+      for_each_array_of(member, [&](const auto &array) { values[at + c++] = array[i]; });
+    });
+    for (int k = 0; k < points.n_state_variables(); ++k)
+      values[first_state_variable + k] = points.state_variables[k][i];
+  }
+
+  template <int dim>
+  void PropertyLayout<dim>::read(const double *values, HostPoints<dim, double> &points, const int i) const
+  {
+    for_each_core_field(points, [&](const PointField field, auto &member) {
+      const int at = offsets[static_cast<int>(field)];
+      if (at < 0)
+        return;
+      int c = 0;
+      for_each_array_of(member, [&](auto &array) {
+        using T  = typename std::decay_t<decltype(array)>::value_type;
+        array[i] = static_cast<T>(values[at + c++]);
+      });
+    });
+    for (int k = 0; k < points.n_state_variables(); ++k)
+      points.state_variables[k][i] = values[first_state_variable + k];
   }
 
   std::string state_variable_count_mismatch(const int given, const std::vector<std::string> &names)
@@ -84,8 +155,9 @@ namespace mpm
   template <int dim>
   MaterialPoints<dim>::MaterialPoints(BackgroundGrid<dim> &grid, const Parameters &parameters)
     : handler(grid.triangulation, grid.mapping,
-              PropertyLayout<dim>::n_properties(parameters.state_variable_names().size()))
+              PropertyLayout<dim>(parameters.point_fields, parameters.state_variable_names()).n_properties())
     , state_variable_names(parameters.state_variable_names())
+    , layout(parameters.point_fields, state_variable_names)
     , grid(grid)
   {
     // The cell weights of the load balance: cell_partition_weight (background_grid.h).
@@ -291,6 +363,7 @@ namespace mpm
     std::map<unsigned int, std::pair<long, long>> clipped; // material -> (points raised to the floor, points)
     for (unsigned int b = 0; b < parameters.bodies.size(); ++b)
       {
+        bodies[b].points.fields    = parameters.point_fields;
         const BodyParameters &body = parameters.bodies[b];
         BodyDescription<dim, double> description;
         description.points_per_direction = body.points_per_direction;
@@ -370,9 +443,8 @@ namespace mpm
   template <int dim>
   void MaterialPoints<dim>::insert(const std::vector<GeneratedBody<dim>> &bodies)
   {
-    using Layout = PropertyLayout<dim>;
     dealii::types::particle_index id = 0;
-    std::vector<double>           properties(Layout::n_properties(state_variable_names.size()));
+    std::vector<double>           properties(layout.n_properties());
     for (const GeneratedBody<dim> &body : bodies)
       {
         const HostPoints<dim, double> &points = body.points;
@@ -390,31 +462,11 @@ namespace mpm
             if (cell == grid.triangulation.end())
               continue; // another rank owns this point's cell
 
-            std::fill(properties.begin(), properties.end(), 0.0);
-            properties[Layout::mass]           = points.mass[i];
-            properties[Layout::volume]         = points.volume[i];
-            properties[Layout::initial_volume] = points.initial_volume[i];
-            for (int d = 0; d < dim; ++d)
-              {
-                properties[Layout::velocity + d]                   = points.velocity[d][i];
-                properties[Layout::domain_half_length + d]         = points.domain_half_length[d][i];
-                properties[Layout::initial_domain_half_length + d] = points.initial_domain_half_length[d][i];
-                properties[Layout::initial_position + d]           = x[d];
-              }
             // F, strain and plastic strain as given (I and zeros for the prm's bodies; a
             // state handed over keeps its own).
-            for (int c = 0; c < dim * dim; ++c)
-              properties[Layout::deformation_gradient + c] = points.deformation_gradient[c][i];
-            for (int c = 0; c < n_voigt; ++c)
-              {
-                properties[Layout::stress + c] = points.stress[c][i];
-                properties[Layout::strain + c] = points.strain[c][i];
-              }
-            properties[Layout::plastic_strain] = points.plastic_strain[i];
-            properties[Layout::material]       = points.material[i];
-            properties[Layout::material_field] = points.material_field[i];
-            for (int k = 0; k < points.n_state_variables(); ++k)
-              properties[Layout::state_variables + k] = points.state_variables[k][i];
+            layout.write(points, i, properties.data());
+            for (int d = 0; d < dim; ++d)
+              properties[layout.offset(PointField::initial_position) + d] = x[d];
 
             dealii::Point<dim> location;
             for (int d = 0; d < dim; ++d)
@@ -465,6 +517,8 @@ namespace mpm
       order[start[cell[g]]++] = g;
 
     p.resize(0);
+    if (!bodies.empty())
+      p.fields = bodies[0].points.fields;
     p.set_n_state_variables(bodies.empty() ? 0 : bodies[0].points.n_state_variables());
     p.resize(n);
     labels.id.resize(n);
@@ -477,29 +531,9 @@ namespace mpm
         const int                      k = source[g].second;
         labels.id[i] = g; // the generation index, as insert() numbers the particles
         for (int d = 0; d < dim; ++d)
-          {
-            p.position[d][i]                   = b.position[d][k];
-            labels.initial_position[d][i]      = b.position[d][k];
-            p.velocity[d][i]                   = b.velocity[d][k];
-            p.domain_half_length[d][i]         = b.domain_half_length[d][k];
-            p.initial_domain_half_length[d][i] = b.initial_domain_half_length[d][k];
-          }
-        // What insert() takes from a body.
-        for (int c = 0; c < n_voigt; ++c)
-          {
-            p.stress[c][i] = b.stress[c][k];
-            p.strain[c][i] = b.strain[c][k];
-          }
-        for (int c = 0; c < dim * dim; ++c)
-          p.deformation_gradient[c][i] = b.deformation_gradient[c][k];
-        p.mass[i]           = b.mass[k];
-        p.volume[i]         = b.volume[k];
-        p.initial_volume[i] = b.initial_volume[k];
-        p.plastic_strain[i] = b.plastic_strain[k];
-        p.material_field[i] = b.material_field[k];
-        p.material[i]       = b.material[k];
-        for (int v = 0; v < p.n_state_variables(); ++v)
-          p.state_variables[v][i] = b.state_variables[v][k];
+          labels.initial_position[d][i] = b.position[d][k];
+        // Every field, as insert() and copy_to() carry them.
+        for_each_point_array<dim>(p, b, [&](auto &to, const auto &from) { to[i] = from[k]; });
       }
   }
 
@@ -507,10 +541,10 @@ namespace mpm
   void MaterialPoints<dim>::copy_to(HostPoints<dim, double> &p, std::vector<long> *home_cells,
                                     PointLabels<dim> *labels) const
   {
-    using Layout = PropertyLayout<dim>;
     const unsigned int n = handler.n_locally_owned_particles();
     const int          n_state = static_cast<int>(state_variable_names.size());
     p.resize(0);
+    p.fields = layout.carried;
     p.set_n_state_variables(n_state);
     p.resize(n);
     if (home_cells)
@@ -529,34 +563,16 @@ namespace mpm
           {
             labels->id[i] = particle.get_id();
             for (int d = 0; d < dim; ++d)
-              labels->initial_position[d][i] = particle.get_properties()[Layout::initial_position + d];
+              labels->initial_position[d][i] =
+                particle.get_properties()[layout.offset(PointField::initial_position) + d];
           }
         const auto x    = particle.get_location();
         const auto prop = particle.get_properties();
         if (home_cells)
           (*home_cells)[i] = grid.lattice_cell_in(particle.get_surrounding_cell(), &x[0]);
         for (int d = 0; d < dim; ++d)
-          {
-            p.position[d][i]                   = x[d];
-            p.velocity[d][i]                   = prop[Layout::velocity + d];
-            p.domain_half_length[d][i]         = prop[Layout::domain_half_length + d];
-            p.initial_domain_half_length[d][i] = prop[Layout::initial_domain_half_length + d];
-          }
-        for (int c = 0; c < n_voigt; ++c)
-          {
-            p.stress[c][i] = prop[Layout::stress + c];
-            p.strain[c][i] = prop[Layout::strain + c];
-          }
-        for (int c = 0; c < dim * dim; ++c)
-          p.deformation_gradient[c][i] = prop[Layout::deformation_gradient + c];
-        p.mass[i]           = prop[Layout::mass];
-        p.volume[i]         = prop[Layout::volume];
-        p.initial_volume[i] = prop[Layout::initial_volume];
-        p.plastic_strain[i] = prop[Layout::plastic_strain];
-        p.material_field[i] = prop[Layout::material_field];
-        p.material[i]       = static_cast<int>(prop[Layout::material]);
-        for (int k = 0; k < n_state; ++k)
-          p.state_variables[k][i] = prop[Layout::state_variables + k];
+          p.position[d][i] = x[d];
+        layout.read(prop.data(), p, i);
         ++i;
       }
   }
@@ -571,6 +587,7 @@ namespace mpm
       if (keep(i))
         kept.push_back(i);
     PointSnapshot<dim> part;
+    part.points.fields = points.fields;
     part.points.set_n_state_variables(points.n_state_variables());
     part.points.resize(static_cast<int>(kept.size()));
     for_each_point_array<dim>(part.points, points, [&](auto &to, const auto &from) {
@@ -590,32 +607,11 @@ namespace mpm
   }
 
   template <int dim>
-  void PointSnapshot<dim>::properties(const int i, double *values) const
+  void PointSnapshot<dim>::properties(const PropertyLayout<dim> &layout, const int i, double *values) const
   {
-    using Layout       = PropertyLayout<dim>;
-    const auto &p      = points;
-    values[Layout::mass]           = p.mass[i];
-    values[Layout::volume]         = p.volume[i];
-    values[Layout::initial_volume] = p.initial_volume[i];
+    layout.write(points, i, values);
     for (int d = 0; d < dim; ++d)
-      {
-        values[Layout::velocity + d]                   = p.velocity[d][i];
-        values[Layout::domain_half_length + d]         = p.domain_half_length[d][i];
-        values[Layout::initial_domain_half_length + d] = p.initial_domain_half_length[d][i];
-        values[Layout::initial_position + d]           = labels->initial_position[d][i];
-      }
-    for (int c = 0; c < n_voigt; ++c)
-      {
-        values[Layout::stress + c] = p.stress[c][i];
-        values[Layout::strain + c] = p.strain[c][i];
-      }
-    for (int c = 0; c < dim * dim; ++c)
-      values[Layout::deformation_gradient + c] = p.deformation_gradient[c][i];
-    values[Layout::plastic_strain] = p.plastic_strain[i];
-    values[Layout::material]       = p.material[i];
-    values[Layout::material_field] = p.material_field[i];
-    for (int k = 0; k < p.n_state_variables(); ++k)
-      values[Layout::state_variables + k] = p.state_variables[k][i];
+      values[layout.offset(PointField::initial_position) + d] = labels->initial_position[d][i];
   }
 
   template <int dim>
@@ -624,7 +620,7 @@ namespace mpm
     AssertThrow(all.points.n_state_variables() == static_cast<int>(state_variable_names.size()),
                 dealii::ExcMessage(state_variable_count_mismatch(all.points.n_state_variables(), state_variable_names)));
     handler.clear_particles();
-    std::vector<double> properties(PropertyLayout<dim>::n_properties(state_variable_names.size()));
+    std::vector<double> properties(layout.n_properties());
     for (int i = 0; i < all.points.size(); ++i)
       {
         if (all.points.material[i] < 0)
@@ -636,7 +632,7 @@ namespace mpm
         const auto cell = grid.owned_cell(grid.lattice_cell_of(x));
         if (cell == grid.triangulation.end())
           continue; // another rank owns this point's cell
-        all.properties(i, properties.data());
+        all.properties(layout, i, properties.data());
         handler.insert_particle(location, grid.mapping.transform_real_to_unit_cell(cell, location),
                                 all.labels->id[i], cell,
                                 dealii::ArrayView<const double>(properties.data(), properties.size()));
@@ -647,7 +643,6 @@ namespace mpm
   template <int dim>
   unsigned int MaterialPoints<dim>::copy_from(const HostPoints<dim, double> &p)
   {
-    using Layout = PropertyLayout<dim>;
     AssertThrow(p.n_state_variables() == static_cast<int>(state_variable_names.size()),
                 dealii::ExcMessage(state_variable_count_mismatch(p.n_state_variables(), state_variable_names)));
     std::vector<typename dealii::Particles::ParticleHandler<dim>::particle_iterator> removed;
@@ -660,24 +655,9 @@ namespace mpm
             continue;
           }
         dealii::Point<dim> x;
-        auto prop = particle->get_properties();
         for (int d = 0; d < dim; ++d)
-          {
-            x[d]                                   = p.position[d][i];
-            prop[Layout::velocity + d]             = p.velocity[d][i];
-            prop[Layout::domain_half_length + d]   = p.domain_half_length[d][i];
-          }
-        for (int c = 0; c < n_voigt; ++c)
-          {
-            prop[Layout::stress + c] = p.stress[c][i];
-            prop[Layout::strain + c] = p.strain[c][i];
-          }
-        for (int c = 0; c < dim * dim; ++c)
-          prop[Layout::deformation_gradient + c] = p.deformation_gradient[c][i];
-        prop[Layout::volume]         = p.volume[i];
-        prop[Layout::plastic_strain] = p.plastic_strain[i];
-        for (int k = 0; k < p.n_state_variables(); ++k)
-          prop[Layout::state_variables + k] = p.state_variables[k][i];
+          x[d] = p.position[d][i];
+        layout.write(p, i, particle->get_properties().data(), true);
         particle->set_location(x);
         if (grid.n_ranks > 1 && grid.owned_cell(grid.lattice_cell_of(&x[0])) == grid.triangulation.end())
           ++n_sent; // now in another rank's cell (a point on a shared face may stay)

@@ -119,7 +119,8 @@ namespace mpm
     {
       std::ofstream table(file_name);
       AssertThrow(table, dealii::ExcMessage("Parameter 'Output/Directory': cannot write '" + file_name + "'."));
-      const auto names = PropertyLayout<dim>::names(snapshot.labels->state_variable_names);
+      const PropertyLayout<dim> layout = snapshot.layout();
+      const auto                names  = layout.names();
       table << "id";
       for (int d = 0; d < dim; ++d)
         table << ",position_" << "xyz"[d];
@@ -139,12 +140,12 @@ namespace mpm
         }
       table << '\n' << std::setprecision(17);
       const auto         &p = snapshot.points;
-      std::vector<double> values(PropertyLayout<dim>::n_properties(p.n_state_variables()));
+      std::vector<double> values(layout.n_properties());
       for (int i = 0; i < p.size(); ++i)
         {
           if (p.material[i] < 0)
             continue; // left the grid
-          snapshot.properties(i, values.data());
+          snapshot.properties(layout, i, values.data());
           table << snapshot.labels->id[i];
           for (int d = 0; d < dim; ++d)
             table << ',' << p.position[d][i];
@@ -340,9 +341,11 @@ namespace mpm
   void PointDataOut<dim>::build_patches(const PointSnapshot<dim> &snapshot, const int begin, const int end)
   {
     const auto        &p            = snapshot.points;
-    const unsigned int n_properties = PropertyLayout<dim>::n_properties(p.n_state_variables());
-    state_variable_names            = snapshot.labels->state_variable_names;
-    const auto fields               = PropertyLayout<dim>::fields(state_variable_names);
+    const PropertyLayout<dim> layout = snapshot.layout();
+    const unsigned int n_properties  = layout.n_properties();
+    state_variable_names             = snapshot.labels->state_variable_names;
+    carried                          = p.fields;
+    const auto fields                = layout.fields();
     components.clear();
     for (unsigned int c = 0; c < n_properties; ++c)
       if (selected_fields.empty() ||
@@ -366,7 +369,7 @@ namespace mpm
         patch.patch_index = k;
         patch.data.reinit(components.size() + 1, 1);
         patch.data(0, 0) = snapshot.labels->id[i];
-        snapshot.properties(i, values.data());
+        snapshot.properties(layout, i, values.data());
         for (unsigned int j = 0; j < components.size(); ++j)
           patch.data(j + 1, 0) = values[components[j]];
         ++k;
@@ -377,7 +380,7 @@ namespace mpm
   std::vector<std::string> PointDataOut<dim>::get_dataset_names() const
   {
     std::vector<std::string> names = {"id"};
-    const auto               all   = PropertyLayout<dim>::names(state_variable_names);
+    const auto               all   = PropertyLayout<dim>(carried, state_variable_names).names();
     for (const unsigned int c : components)
       names.push_back(all[c]);
     return names;
@@ -390,7 +393,7 @@ namespace mpm
     using namespace dealii::DataComponentInterpretation;
     const auto names = get_dataset_names();
     std::vector<DataComponentInterpretation> kinds = {component_is_scalar};
-    const auto all = PropertyLayout<dim>::interpretations(state_variable_names.size());
+    const auto all = PropertyLayout<dim>(carried, state_variable_names).interpretations();
     for (const unsigned int c : components)
       kinds.push_back(all[c]);
     Ranges ranges;

@@ -135,7 +135,7 @@ namespace mpm
     void check_particle_fields_of(const Parameters &p)
     {
       std::vector<std::string> allowed;
-      for (const std::string &field : PropertyLayout<dim>::fields(p.state_variable_names()))
+      for (const std::string &field : PropertyLayout<dim>(p.point_fields, p.state_variable_names()).fields())
         if (std::find(allowed.begin(), allowed.end(), field) == allowed.end())
           allowed.push_back(field);
       for (const std::string &given : p.output.particle_fields)

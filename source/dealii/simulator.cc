@@ -51,7 +51,8 @@ namespace mpm
     // needs all of them (it keeps those in its MPM cells, as with the prm's bodies, which
     // every rank generates whole), in one order on every rank: rank by rank.
     template <int dim>
-    std::vector<GeneratedBody<dim>> gather_bodies(const std::vector<GeneratedBody<dim>> &local, MPI_Comm comm)
+    std::vector<GeneratedBody<dim>> gather_bodies(const std::vector<GeneratedBody<dim>> &local,
+                                                  const PointFieldSet &fields, MPI_Comm comm)
     {
       std::vector<double> packed; // per body: its numbers of points and state variables, every array
       for (const GeneratedBody<dim> &body : local)
@@ -66,6 +67,7 @@ namespace mpm
         for (std::size_t at = 0; at < from_rank.size();)
           {
             GeneratedBody<dim> body;
+            body.points.fields          = fields;
             const int          n_points = static_cast<int>(from_rank[at++]);
             body.points.set_n_state_variables(static_cast<int>(from_rank[at++]));
             body.points.resize(n_points);
@@ -115,7 +117,10 @@ namespace mpm
       HostPoints<dim, double>        &to = one[0].points;
       for (const GeneratedBody<dim> &body : bodies) // an empty body (a rank without cells) may hold none
         if (body.points.size() > 0)
-          to.set_n_state_variables(body.points.n_state_variables());
+          {
+            to.fields = body.points.fields;
+            to.set_n_state_variables(body.points.n_state_variables());
+          }
       to.resize(static_cast<int>(source.size()));
       for (std::size_t k = 0; k < source.size(); ++k)
         for_each_point_array<dim>(to, bodies[source[k].first].points,
@@ -125,6 +130,24 @@ namespace mpm
 
     // Points given to setup() carry the state variables of the run's models (an empty body,
     // from a rank without FEM cells, may carry none).
+    // Points handed over carry the run's fields (point_fields.h): those they lack start at
+    // their initial value; a field the run does not carry is refused, by name.
+    template <int dim>
+    void carry_the_run_fields(std::vector<GeneratedBody<dim>> &bodies, const PointFieldSet &run)
+    {
+      for (GeneratedBody<dim> &body : bodies)
+        for (int f = 0; f < n_point_fields; ++f)
+          {
+            const PointField field = static_cast<PointField>(f);
+            AssertThrow(!body.points.fields.has(field) || run.has(field),
+                        dealii::ExcMessage(std::string("Simulator::setup(bodies): the points handed over carry the "
+                                                       "field '") + info(field).member +
+                                           "', which this run does not (Parameters::point_fields)."));
+            if (run.has(field) && !body.points.fields.has(field))
+              body.points.carry(field);
+          }
+    }
+
     template <int dim>
     void check_state_variable_count(const std::vector<GeneratedBody<dim>> &bodies, const Parameters &p)
     {
@@ -197,8 +220,9 @@ namespace mpm
     s.h    = parameters.cell_size;
     if (given_bodies != nullptr)
       {
+        carry_the_run_fields(*given_bodies, parameters.point_fields);
         if (s.parallel)
-          *given_bodies = gather_bodies(*given_bodies, s.communicator);
+          *given_bodies = gather_bodies(*given_bodies, parameters.point_fields, s.communicator);
         // APIC's affine matrices and CPDI2q's corners are the program's, not the caller's: points
         // handed over without them start with C = 0 and their initial rectangles.
         const int own = parameters.affine_state_variable() >= 0 ? parameters.affine_state_variable() :

@@ -83,6 +83,7 @@ namespace mpm
     PointSnapshot<dim> all;
     auto               labels = std::make_shared<PointLabels<dim>>();
     labels->state_variable_names = snapshot.labels->state_variable_names;
+    all.points.fields = new_points.fields;
     all.points.set_n_state_variables(new_points.n_state_variables());
     all.points.resize(total);
     int offset = 0;

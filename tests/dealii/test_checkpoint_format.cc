@@ -1,6 +1,6 @@
 // Checkpoint files of another format are refused by name: a run.state of format 1 (before the
-// strength divisor, 2026-12-03) says so, and a file of no known format says it is not a checkpoint.
-// (That format 2 carries the divisor through: prm/checkpoint/TERM_prefailure_resume.)
+// strength divisor, 2026-12-03) or 2 (before the named point fields, 2026-12-07) says so, and a file of no known format says it is not a checkpoint.
+// (That format 3 carries the divisor through: prm/checkpoint/TERM_prefailure_resume.)
 #include <mpm/dealii/checkpoint.h>
 
 #include <deal.II/base/exceptions.h>
@@ -59,6 +59,9 @@ int main()
   write_mark(root + "/format1", 0x4d504d01);
   expect(refusal(root + "/format1").find("checkpoint format 1") != std::string::npos,
          "a format-1 run.state is refused as written by an earlier dealii-mpm");
+  write_mark(root + "/format2", 0x4d504d02);
+  expect(refusal(root + "/format2").find("checkpoint format 2, before 2026-12-07") != std::string::npos,
+         "a format-2 run.state (arrays in a fixed order, no field names) is refused as earlier");
   write_mark(root + "/other", 12345);
   expect(refusal(root + "/other").find("is not a dealii-mpm checkpoint file") != std::string::npos,
          "a run.state of no known format is refused as not a checkpoint");

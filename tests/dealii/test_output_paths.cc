@@ -155,7 +155,7 @@ namespace
     BackgroundGrid<dim> grid(parameters, MPI_COMM_WORLD);
     MaterialPoints<dim> points(grid, parameters);
     points.generate(parameters);
-    using Layout = PropertyLayout<dim>;
+    const PropertyLayout<dim>      &layout      = points.layout;
     const std::vector<std::string> &state_names = points.state_variable_names;
     mpm_test::check(state_names == std::vector<std::string>{"void_ratio", "damage"},
                     "the points carry the model's two state variables");
@@ -165,14 +165,14 @@ namespace
     for (auto &particle : points.handler)
       {
         auto properties = particle.get_properties();
-        for (unsigned int k = 0; k < Layout::n_properties(state_names.size()); ++k)
+        for (unsigned int k = 0; k < layout.n_properties(); ++k)
           properties[k] = 1000.0 * (k + 1) + 0.37 * particle.get_id() + 1e-3 * k * k;
-        properties[Layout::material] = 3;
+        properties[layout.offset(PointField::material)] = 3;
       }
 
     // Old path: the handler through Particles::DataOut.
     dealii::Particles::DataOut<dim> from_handler;
-    from_handler.build_patches(points.handler, Layout::names(state_names), Layout::interpretations(state_names.size()));
+    from_handler.build_patches(points.handler, layout.names(), layout.interpretations());
     // New path: the core's arrays (as the engine loads them) through PointDataOut.
     PointSnapshot<dim> snapshot;
     auto               labels = std::make_shared<PointLabels<dim>>();
@@ -211,7 +211,7 @@ namespace
     std::advance(it, gone);
     points.handler.remove_particle(it);
     Exposed<dealii::Particles::DataOut<dim>> from_handler_after;
-    from_handler_after.build_patches(points.handler, Layout::names(state_names), Layout::interpretations(state_names.size()));
+    from_handler_after.build_patches(points.handler, layout.names(), layout.interpretations());
     Exposed<PointDataOut<dim>> from_snapshot_after;
     from_snapshot_after.build_patches(snapshot);
     const auto old_patches = by_id(from_handler_after.get_patches());

@@ -57,6 +57,11 @@ void column_agreement(const char *shape, const DomainUpdate update)
   ColumnSetup           setup{32, 0.5, update};
   setup.max_steps = 0;
   elastic_column<Shape, CpuTarget>(setup, initial);
+  // A field the run asks for (point_fields.h: test_tag, which no stage updates) travels with its
+  // points through the device's sorts and comes back in the upload order.
+  initial.carry(PointField::test_tag);
+  for (int i = 0; i < initial.size(); ++i)
+    initial.test_tag[i] = 1 + i;
   setup.max_steps = n;
   elastic_column<Shape, CpuTarget>(setup, cpu, &initial);
   const Difference spread = cpu_reordering_spread(initial, cpu, 10.0 / 32, [&](auto &out, const auto *start) {
@@ -68,6 +73,11 @@ void column_agreement(const char *shape, const DomainUpdate update)
   elastic_column<Shape, CudaSortedTarget>(setup, gpu, &initial);
   report<2>((std::string("V1 column ") + shape + ", GPU sorted every 7").c_str(), compare_points(cpu, gpu, 10.0 / 32),
             spread, n, true);
+  bool tags_kept = gpu.fields.has(PointField::test_tag) && gpu.test_tag.size() == initial.test_tag.size() &&
+                   cpu.test_tag == initial.test_tag;
+  for (int i = 0; tags_kept && i < gpu.size(); ++i)
+    tags_kept = gpu.test_tag[i] == initial.test_tag[i];
+  check(tags_kept, (std::string("V1 column ") + shape + ": test_tag follows every point through the GPU's sorts").c_str());
 }
 
 // The spinning block on the given target: cpGIMP with the U domain update, the cubic

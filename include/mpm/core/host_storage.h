@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <stdexcept>
+#include <string>
 #include <type_traits>
 #include <utility>
 #include <vector>
@@ -24,32 +25,17 @@ namespace mpm
   {};
 
   // The view of any owner of point arrays (HostPoints, the CUDA backend's DevicePoints):
-  // arrays with .data() under the member names of HostPoints.
+  // the core fields of point_fields.h under their member names, arrays with .data(); null
+  // for the fields the owner does not carry.
   template <int dim, typename Real, typename Storage>
   PointsView<dim, Real> make_points_view(Storage &s)
   {
     PointsView<dim, Real> v;
     v.n_points = s.size();
-    for (int d = 0; d < dim; ++d)
-      {
-        v.position[d]                   = s.position[d].data();
-        v.velocity[d]                   = s.velocity[d].data();
-        v.domain_half_length[d]         = s.domain_half_length[d].data();
-        v.initial_domain_half_length[d] = s.initial_domain_half_length[d].data();
-      }
-    for (int c = 0; c < n_voigt; ++c)
-      {
-        v.stress[c] = s.stress[c].data();
-        v.strain[c] = s.strain[c].data();
-      }
-    for (int c = 0; c < dim * dim; ++c)
-      v.deformation_gradient[c] = s.deformation_gradient[c].data();
-    v.mass           = s.mass.data();
-    v.volume         = s.volume.data();
-    v.initial_volume = s.initial_volume.data();
-    v.plastic_strain = s.plastic_strain.data();
-    v.material_field = s.material_field.data();
-    v.material       = s.material.data();
+    for_each_core_field(v, s, [&](const PointField field, auto &view, auto &arrays) {
+      if (s.fields.has(field))
+        for_each_array_of(view, arrays, [](auto *&pointer, auto &array) { pointer = array.data(); });
+    });
     if constexpr (has_state_variables<Storage>::value)
       {
         v.n_state_variables = static_cast<int>(s.state_variables.size());
@@ -60,31 +46,20 @@ namespace mpm
   }
 
   // Visits the matching arrays of two owners of point arrays (HostPoints, DevicePoints,
-  // or one owner twice) as f(array of a, array of b): upload, download, permutation.
-  // State variables are visited where both hold them, a's count of them (b has as many).
+  // or one owner twice) as f(array of a, array of b): upload, download, permutation,
+  // checkpoints. The fields both carry (both must carry the same), then the state variables
+  // where both hold them, a's count of them (b has as many).
   template <int dim, typename A, typename B, typename F>
   void for_each_point_array(A &a, B &b, F &&f)
   {
-    for (int d = 0; d < dim; ++d)
-      {
-        f(a.position[d], b.position[d]);
-        f(a.velocity[d], b.velocity[d]);
-        f(a.domain_half_length[d], b.domain_half_length[d]);
-        f(a.initial_domain_half_length[d], b.initial_domain_half_length[d]);
-      }
-    for (int c = 0; c < n_voigt; ++c)
-      {
-        f(a.stress[c], b.stress[c]);
-        f(a.strain[c], b.strain[c]);
-      }
-    for (int c = 0; c < dim * dim; ++c)
-      f(a.deformation_gradient[c], b.deformation_gradient[c]);
-    f(a.mass, b.mass);
-    f(a.volume, b.volume);
-    f(a.initial_volume, b.initial_volume);
-    f(a.plastic_strain, b.plastic_strain);
-    f(a.material_field, b.material_field);
-    f(a.material, b.material);
+    for_each_core_field(a, b, [&](const PointField field, auto &arrays_a, auto &arrays_b) {
+      if (a.fields.has(field) != b.fields.has(field))
+        throw std::invalid_argument(std::string("for_each_point_array: the field '") + info(field).member +
+                                    "' is carried by one owner of point arrays and not by the other (copy "
+                                    "PointFieldSet fields before resizing an owner to be filled).");
+      if (a.fields.has(field))
+        for_each_array_of(arrays_a, arrays_b, f);
+    });
     if constexpr (has_state_variables<std::decay_t<A>>::value && has_state_variables<std::decay_t<B>>::value)
       {
         if (b.state_variables.size() < a.state_variables.size())
@@ -95,52 +70,54 @@ namespace mpm
       }
   }
 
+  // Point arrays in host memory: the core fields of point_fields.h that `fields` names (the
+  // others stay empty), and the state variables.
   template <int dim, typename Real>
   struct HostPoints
   {
-    std::vector<Real> position[dim], velocity[dim], mass, volume, initial_volume, stress[n_voigt],
-      strain[n_voigt], deformation_gradient[dim * dim], domain_half_length[dim], initial_domain_half_length[dim], plastic_strain,
-      material_field;
-    std::vector<int> material;
+    template <typename T>
+    using FieldArray = std::vector<T>;
+
+    MPM_POINT_CORE_MEMBERS
     // The user models' state variables (PointsView::state_variables): one array per
     // variable, none unless a model of the run declares some.
     std::vector<std::vector<Real>> state_variables;
+    // The fields these points carry (set before resize; carry() adds one later).
+    PointFieldSet fields;
 
-    int size() const { return static_cast<int>(mass.size()); }
+    int size() const { return static_cast<int>(mass.size()); } // mass: every run carries it
     int n_state_variables() const { return static_cast<int>(state_variables.size()); }
 
     // Holds n state variable arrays (of the current size); resize() keeps their number.
-    void set_n_state_variables(const int n)
+    void set_n_state_variables(const int count)
     {
-      state_variables.resize(n);
+      state_variables.resize(count);
       for (auto &array : state_variables)
         array.resize(mass.size());
     }
 
-    void resize(const int n)
+    // Carries `field` from now on, its new arrays at their initial value.
+    void carry(const PointField field)
     {
-      for (int d = 0; d < dim; ++d)
-        {
-          position[d].resize(n);
-          velocity[d].resize(n);
-          domain_half_length[d].resize(n);
-          initial_domain_half_length[d].resize(n);
-        }
-      for (int c = 0; c < n_voigt; ++c)
-        {
-          stress[c].resize(n);
-          strain[c].resize(n);
-        }
-      for (int c = 0; c < dim * dim; ++c)
-        deformation_gradient[c].resize(n, c % (dim + 1) == 0 ? Real(1) : Real(0));
-      mass.resize(n);
-      volume.resize(n);
-      initial_volume.resize(n);
-      plastic_strain.resize(n);
-      material_field.resize(n);
-      material.resize(n);
+      fields.insert(field);
+      resize(size());
+    }
+
+    // n points: new ones at each field's initial value (zero; the identity for F).
+    void resize(const int count)
+    {
+      for_each_core_field(*this, [&](const PointField field, auto &member) {
+        if (!fields.has(field))
+          return;
+        int c = 0;
+        for_each_array_of(member, [&](auto &array) {
+          const bool diagonal = info(field).identity && c % (dim + 1) == 0;
+          array.resize(count, diagonal ? 1 : 0);
+          ++c;
+        });
+      });
       for (auto &array : state_variables)
-        array.resize(n);
+        array.resize(count);
     }
 
     PointsView<dim, Real> view() { return make_points_view<dim, Real>(*this); }

@@ -96,6 +96,7 @@ namespace mpm
   void convert_points(const HostPoints<dim, From> &from, HostPoints<dim, To> &to)
   {
     to.state_variables.clear();
+    to.fields = from.fields;
     to.resize(from.size());
     to.set_n_state_variables(from.n_state_variables());
     for_each_point_array<dim>(from, to, [](const auto &a, auto &b) { b.assign(a.begin(), a.end()); });

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <mpm/core/config.h>
+#include <mpm/core/point_fields.h>
 
 #include <cmath>
 #include <cstdint>
@@ -204,26 +205,19 @@ namespace mpm
     }
   };
 
-  // Material point arrays. material[p] < 0 marks a point that left the grid.
+  // Material point arrays: one member per core field of point_fields.h (position[d],
+  // mass, stress[c], material, ...; null where the run's points do not carry it).
+  // material[p] < 0 marks a point that left the grid.
   template <int dim, typename Real>
   struct PointsView
   {
-    int   n_points;
-    Real *position[dim];
-    Real *velocity[dim];
-    Real *mass;
-    Real *volume;
-    Real *initial_volume;
-    Real *stress[n_voigt];
-    Real *strain[n_voigt];  // accumulated small-strain measure, for output
-    Real *deformation_gradient[dim * dim]; // F, row-major; plane strain keeps F_zz = 1
-    Real *domain_half_length[dim];         // GIMP particle half-lengths (current)
-    Real *initial_domain_half_length[dim]; // at the reference configuration
-    Real *plastic_strain;                  // accumulated equivalent plastic strain
-    Real *material_field;                  // per-point value of the material's random-field parameter
-    int  *material;
-    // State variables of user models (user_model.h): variable k of point i is
-    // state_variables[k][i]. None (0) unless a model of the run declares some; never on the GPU.
+    template <typename T>
+    using FieldArray = T *;
+
+    int n_points = 0;
+    MPM_POINT_CORE_MEMBERS
+    // State variables of user models (user_model.h) or of the affine transfers: variable k
+    // of point i is state_variables[k][i]. None (0) unless the run's models declare some.
     Real *state_variables[max_state_variables] = {};
     int   n_state_variables                     = 0;
   };
@@ -237,31 +231,9 @@ namespace mpm
       if (array != nullptr)
         array += first;
     };
-    for (int d = 0; d < dim; ++d)
-      {
-        shift(p.position[d]);
-        shift(p.velocity[d]);
-        shift(p.domain_half_length[d]);
-        shift(p.initial_domain_half_length[d]);
-      }
-    for (int c = 0; c < n_voigt; ++c)
-      {
-        shift(p.stress[c]);
-        shift(p.strain[c]);
-      }
-    for (int k = 0; k < dim * dim; ++k)
-      shift(p.deformation_gradient[k]);
+    for_each_core_field(p, [&](PointField, auto &member) { for_each_array_of(member, shift); });
     for (int k = 0; k < p.n_state_variables; ++k)
       shift(p.state_variables[k]);
-    shift(p.mass);
-    shift(p.volume);
-    shift(p.initial_volume);
-    shift(p.plastic_strain);
-    shift(p.material_field);
-    shift(p.material);
-    static_assert(sizeof(PointsView<dim, Real>) ==
-                    sizeof(void *) * (4 * dim + 2 * n_voigt + dim * dim + 6 + max_state_variables + 2),
-                  "point_range shifts every array of PointsView: shift the one added too");
     return p;
   }
 } // namespace mpm

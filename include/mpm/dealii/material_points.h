@@ -20,36 +20,40 @@
 
 namespace mpm
 {
-  // Offsets of each property in a particle's property array.
+  // The points' properties in a particle's property array: the fields of point_fields.h that
+  // live in the handler and that the run's points carry, in the list's order, then one per
+  // state variable of the run's models (Parameters::state_variable_names).
   template <int dim>
-  struct PropertyLayout
+  class PropertyLayout
   {
-    static constexpr unsigned int mass                 = 0;
-    static constexpr unsigned int volume               = 1;
-    static constexpr unsigned int initial_volume       = 2;
-    static constexpr unsigned int velocity             = 3;
-    static constexpr unsigned int stress               = velocity + dim;
-    static constexpr unsigned int strain               = stress + n_voigt;
-    static constexpr unsigned int deformation_gradient = strain + n_voigt;
-    static constexpr unsigned int domain_half_length   = deformation_gradient + dim * dim;
-    static constexpr unsigned int initial_domain_half_length = domain_half_length + dim;
-    static constexpr unsigned int plastic_strain       = initial_domain_half_length + dim;
-    static constexpr unsigned int material             = plastic_strain + 1;
-    static constexpr unsigned int initial_position     = material + 1;
-    static constexpr unsigned int material_field       = initial_position + dim;
-    // Then one per state variable of the run's models (Parameters::state_variable_names).
-    static constexpr unsigned int state_variables      = material_field + 1;
+  public:
+    explicit PropertyLayout(const PointFieldSet &fields = {}, const std::vector<std::string> &state_variable_names = {});
 
-    static constexpr unsigned int n_properties(const unsigned int n_state_variables)
-    {
-      return state_variables + n_state_variables;
-    }
-    static std::vector<std::string> names(const std::vector<std::string> &state_variable_names = {});
+    // Where a carried field's first component sits.
+    unsigned int offset(PointField field) const;
+    unsigned int state_variables() const { return first_state_variable; }
+    unsigned int n_properties() const { return first_state_variable + state_variable_names.size(); }
+
+    // One name per property: a vector's name once per component, name_xx ... for Voigt and
+    // tensor components, then the state variables' names.
+    std::vector<std::string> names() const;
     // The field each property belongs to, as Output/Particle fields names it: "stress" for
     // stress_xx ... stress_xz, "strain" and "F" likewise, else the property's own name.
-    static std::vector<std::string> fields(const std::vector<std::string> &state_variable_names = {});
-    static std::vector<dealii::DataComponentInterpretation::DataComponentInterpretation>
-    interpretations(unsigned int n_state_variables = 0);
+    std::vector<std::string> fields() const;
+    std::vector<dealii::DataComponentInterpretation::DataComponentInterpretation> interpretations() const;
+
+    // Point i's core fields (and state variables) into `values`, laid out as above; only those
+    // the step writes if `written_only` (the rest stay as they are).
+    void write(const HostPoints<dim, double> &points, int i, double *values, bool written_only = false) const;
+    // And back: `values` into point i.
+    void read(const double *values, HostPoints<dim, double> &points, int i) const;
+
+    const PointFieldSet                carried;
+    const std::vector<std::string>     state_variable_names;
+
+  private:
+    int          offsets[n_point_fields];
+    unsigned int first_state_variable = 0;
   };
 
   // What the core's arrays do not hold but output needs, per point in the engine's
@@ -86,10 +90,12 @@ namespace mpm
         }
     }
 
-    // Property array of point i in the handler's layout (PropertyLayout): the values the
-    // handler would hold after a hand-over. values holds
-    // PropertyLayout<dim>::n_properties(points.n_state_variables()) entries.
-    void properties(int i, double *values) const;
+    // Property array of point i in the handler's layout: the values the handler would hold
+    // after a hand-over. values holds layout.n_properties() entries.
+    void properties(const PropertyLayout<dim> &layout, int i, double *values) const;
+
+    // The layout of these points' properties.
+    PropertyLayout<dim> layout() const { return PropertyLayout<dim>(points.fields, labels->state_variable_names); }
 
     // The points i for which keep(i) holds, with their labels, in their order.
     PointSnapshot selected(const std::function<bool(int)> &keep) const;
@@ -179,6 +185,8 @@ namespace mpm
 
     // The names of the state variables every point carries (Parameters::state_variable_names).
     const std::vector<std::string> state_variable_names;
+    // Where each field of the points sits in a particle's properties.
+    const PropertyLayout<dim> layout;
 
   private:
     BackgroundGrid<dim> &grid;

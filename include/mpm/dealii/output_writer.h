@@ -52,6 +52,7 @@ namespace mpm
   private:
     std::vector<dealii::DataOutBase::Patch<0, dim>> patches;
     std::vector<std::string>                        state_variable_names; // of the snapshot
+    PointFieldSet                                   carried;              // the snapshot's fields
     std::vector<std::string>                        selected_fields;
     std::vector<unsigned int>                       components; // the properties written, in order
   };

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <mpm/core/material/material.h>
+#include <mpm/core/point_fields.h>
 #include <mpm/core/shape_functions.h>
 #include <mpm/core/step/settings.h>
 #include <mpm/dealii/backend_settings.h>
@@ -114,6 +115,10 @@ namespace mpm
     InitialStateSettings initial_state; // Initial state
 
     BackendSettings backend; // Backend
+
+    // The fields every point of the run carries (point_fields.h): those of every run, and those
+    // a physics module or a test asks for. Not read from the prm.
+    PointFieldSet point_fields;
 
     // The state variables every point of the run carries (user_model.h): their names, the
     // longest list the materials' models declare (where two models name variable k

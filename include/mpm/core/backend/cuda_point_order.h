@@ -168,6 +168,7 @@ namespace mpm
       const int n = points.size();
       if (static_cast<int>(original.size()) != n)
         throw std::logic_error("PointOrder::download_in_reference_order: the order was not reset for these points");
+      host.fields = points.fields;
       if (host.n_state_variables() < points.n_state_variables())
         host.set_n_state_variables(points.n_state_variables());
       for_each_point_array<dim>(points, host, [&](const auto &device, auto &out) {

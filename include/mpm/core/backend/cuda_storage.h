@@ -113,37 +113,45 @@ namespace mpm
     size_t capacity = 0;
   };
 
+  // Point arrays in device memory: the fields of the uploaded points (point_fields.h).
   template <int dim, typename Real>
   struct DevicePoints
   {
-    DeviceArray<Real> position[dim], velocity[dim], mass, volume, initial_volume, stress[n_voigt], strain[n_voigt],
-      deformation_gradient[dim * dim], domain_half_length[dim], initial_domain_half_length[dim], plastic_strain,
-      material_field;
-    DeviceArray<int> material;
+    template <typename T>
+    using FieldArray = DeviceArray<T>;
+
+    MPM_POINT_CORE_MEMBERS
     // The affine transfers' matrices (StepSettings::affine_state_variable): as many arrays as
     // the uploaded points hold, none unless the run uses TPIC or APIC.
     std::vector<DeviceArray<Real>> state_variables;
+    PointFieldSet                  fields; // those of the uploaded points
 
     int size() const { return static_cast<int>(mass.size()); }
     int n_state_variables() const { return static_cast<int>(state_variables.size()); }
 
     void upload(const HostPoints<dim, Real> &h)
     {
+      fields = h.fields;
       state_variables.resize(h.state_variables.size());
       for_each_point_array<dim>(*this, h, [](auto &device, const auto &host) { device.upload(host); });
     }
 
     void download(HostPoints<dim, Real> &h) const
     {
+      h.fields = fields;
       if (h.n_state_variables() < n_state_variables())
         h.set_n_state_variables(n_state_variables());
       for_each_point_array<dim>(*this, h, [](const auto &device, auto &host) { device.download(host); });
     }
 
-    // Bytes of device memory held per point, without state variables.
-    static constexpr size_t bytes_per_point()
+    // Bytes of device memory held per point by the fields `carried`, without state variables.
+    static constexpr size_t bytes_per_point(const PointFieldSet carried = {})
     {
-      return (4 * dim + 5 + 2 * n_voigt + dim * dim) * sizeof(Real) + sizeof(int);
+      size_t bytes = 0;
+      for (int f = 0; f < n_point_fields; ++f)
+        if (point_field_info[f].place != FieldPlace::handler && carried.has(static_cast<PointField>(f)))
+          bytes += field_arrays<dim>(point_field_info[f].shape) * (point_field_info[f].integer ? sizeof(int) : sizeof(Real));
+      return bytes;
     }
 
     PointsView<dim, Real> view() { return make_points_view<dim, Real>(*this); }
