@@ -1,4 +1,5 @@
 #include <mpm/dealii/initial_state_settings.h>
+#include <mpm/dealii/parameter_error.h>
 
 #include <deal.II/base/exceptions.h>
 #include <deal.II/base/utilities.h>
@@ -10,15 +11,6 @@ namespace mpm
 {
   using dealii::ParameterHandler;
   namespace Patterns = dealii::Patterns;
-
-  namespace
-  {
-    [[noreturn]] void fail(const std::string &entry, const std::string &what)
-    {
-      AssertThrow(false, dealii::ExcMessage("Parameter '" + entry + "': " + what));
-      std::abort();
-    }
-  } // namespace
 
   void InitialStateSettings::declare(ParameterHandler &prm)
   {
@@ -77,11 +69,11 @@ namespace mpm
     equilibration_tolerance     = prm.get_double("Equilibration tolerance");
     equilibration_maximum_steps = prm.get_integer("Equilibration maximum steps");
     if (equilibrate && !(equilibration_damping > 0 && equilibration_damping < 1))
-      fail("Initial state/Equilibration damping", "must lie between 0 and 1 (exclusive) where Equilibrate = true.");
+      parameter_error("Initial state/Equilibration damping", "must lie between 0 and 1 (exclusive) where Equilibrate = true.");
     if (equilibrate && !(equilibration_tolerance > 0))
-      fail("Initial state/Equilibration tolerance", "must be > 0 where Equilibrate = true.");
+      parameter_error("Initial state/Equilibration tolerance", "must be > 0 where Equilibrate = true.");
     if (source == "FEM file" && fem_file.empty())
-      fail("Initial state/FEM file", "Source = FEM file needs the file's name.");
+      parameter_error("Initial state/FEM file", "Source = FEM file needs the file's name.");
     // Read where given: the FEM file needs them, and so does a pre-failure analysis of a mesh
     // file (run/scene.h checks that).
     if (source == "FEM file" || !dealii::Utilities::trim(prm.get("Materials")).empty())
@@ -94,7 +86,7 @@ namespace mpm
               colon == std::string::npos ? std::vector<std::string>() :
                                            dealii::Utilities::split_string_list(item.substr(colon + 1), ',');
             if (rest.size() != 2)
-              fail(where, "'" + item + "' is not of the form 'id: material name, density'.");
+              parameter_error(where, "'" + item + "' is not of the form 'id: material name, density'.");
             int    id      = -1;
             double density = 0;
             try
@@ -104,18 +96,18 @@ namespace mpm
               }
             catch (...)
               {
-                fail(where, "'" + item + "' is not of the form 'id: material name, density'.");
+                parameter_error(where, "'" + item + "' is not of the form 'id: material name, density'.");
               }
             const auto name = std::find(material_names.begin(), material_names.end(), rest[0]);
             if (id < 0 || id > 255 || !(density > 0) || name == material_names.end() || materials.count(id))
-              fail(where, "'" + item + "': the id must be a material_id 0..255 given once, the name one of "
+              parameter_error(where, "'" + item + "': the id must be a material_id 0..255 given once, the name one of "
                           "Materials/Names, the density > 0.");
             if (material_parameters[name - material_names.begin()].field_parameter != FieldParameter::none)
-              fail(where, "material '" + rest[0] + "' has a random field, which the FEM hand-over does not carry.");
+              parameter_error(where, "material '" + rest[0] + "' has a random field, which the FEM hand-over does not carry.");
             materials[id] = {static_cast<unsigned int>(name - material_names.begin()), density};
           }
         if (materials.empty() && source == "FEM file")
-          fail("Initial state/Materials", "Source = FEM file needs at least one 'id: material name, density'.");
+          parameter_error("Initial state/Materials", "Source = FEM file needs at least one 'id: material name, density'.");
       }
   }
 } // namespace mpm

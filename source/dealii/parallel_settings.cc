@@ -1,4 +1,5 @@
 #include <mpm/dealii/parallel_settings.h>
+#include <mpm/dealii/parameter_error.h>
 
 #include <deal.II/base/exceptions.h>
 
@@ -9,15 +10,6 @@ namespace mpm
 {
   using dealii::ParameterHandler;
   namespace Patterns = dealii::Patterns;
-
-  namespace
-  {
-    [[noreturn]] void fail(const std::string &entry, const std::string &what)
-    {
-      AssertThrow(false, dealii::ExcMessage("Parameter '" + entry + "': " + what));
-      std::abort();
-    }
-  } // namespace
 
   void ParallelSettings::declare(ParameterHandler &prm)
   {
@@ -44,7 +36,7 @@ namespace mpm
     load_balance_threshold = prm.get_double("Load balance threshold");
     point_weight           = prm.get_double("Point weight");
     if (load_balance_threshold > 0 && load_balance_threshold < 1)
-      fail("Parallel/Load balance threshold", "must be 0 (never repartition) or at least 1, got " +
+      parameter_error("Parallel/Load balance threshold", "must be 0 (never repartition) or at least 1, got " +
                                                  prm.get("Load balance threshold") + ".");
   }
 } // namespace mpm

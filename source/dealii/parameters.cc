@@ -1,4 +1,5 @@
 #include <mpm/dealii/guards.h>
+#include <mpm/dealii/parameter_error.h>
 #include <mpm/dealii/material_library.h>
 #include <mpm/dealii/material_points.h>
 #include <mpm/dealii/method_choice.h>
@@ -47,8 +48,6 @@ namespace mpm
     {
       return Patterns::List(Patterns::Double(), dim, dim, ",");
     }
-
-    [[noreturn]] void fail(const std::string &entry, const std::string &what);
 
     // The first two edges of a closed polygon that meet other than at the vertex they share
     // (edge k runs from vertex k to vertex k + 1, the last back to vertex 0), or {-1, -1}: the
@@ -102,7 +101,7 @@ namespace mpm
             }
           catch (...)
             {
-              fail(entry, "'" + item + "' is not a finite double-precision number (magnitudes from about "
+              parameter_error(entry, "'" + item + "' is not a finite double-precision number (magnitudes from about "
                           "2.2e-308 to 1.8e308, or 0).");
             }
         }
@@ -123,11 +122,6 @@ namespace mpm
       return s;
     }
 
-    [[noreturn]] void fail(const std::string &entry, const std::string &what)
-    {
-      AssertThrow(false, ExcMessage("Parameter '" + entry + "': " + what));
-      throw; // not reached
-    }
 
     // Output/Particle fields: each a field of the run's points (PropertyLayout::fields, whose
     // names depend on the dimension and the models' state variables), or id or position.
@@ -140,10 +134,10 @@ namespace mpm
           allowed.push_back(field);
       for (const std::string &given : p.output.particle_fields)
         if (given == "all")
-          fail("Output/Particle fields", "'all' stands alone; it cannot be combined with other fields.");
+          parameter_error("Output/Particle fields", "'all' stands alone; it cannot be combined with other fields.");
         else if (given != "id" && given != "position" &&
             std::find(allowed.begin(), allowed.end(), given) == allowed.end())
-          fail("Output/Particle fields", "'" + given + "' is not a field of the points. Allowed: all, or a list of " +
+          parameter_error("Output/Particle fields", "'" + given + "' is not a field of the points. Allowed: all, or a list of " +
                                            join(allowed) + " (id and position are always written).");
     }
 
@@ -460,14 +454,14 @@ namespace mpm
     upper     = get_point(prm, "Upper corner", "Grid/");
     cell_size = prm.get_double("Cell size");
     if (!(cell_size > 0))
-      fail("Grid/Cell size", "must be > 0, got " + prm.get("Cell size") + ".");
+      parameter_error("Grid/Cell size", "must be > 0, got " + prm.get("Cell size") + ".");
     for (unsigned int d = 0; d < dim; ++d)
       {
         if (!(upper[d] > lower[d]))
-          fail("Grid/Upper corner", std::string("must exceed Lower corner in ") + axis_names[d] + ".");
+          parameter_error("Grid/Upper corner", std::string("must exceed Lower corner in ") + axis_names[d] + ".");
         const double n = (upper[d] - lower[d]) / cell_size;
         if (std::abs(n - std::round(n)) > 1e-8 * std::max(1.0, n))
-          fail("Grid/Cell size", std::string("the extent in ") + axis_names[d] + " (" +
+          parameter_error("Grid/Cell size", std::string("the extent in ") + axis_names[d] + " (" +
                                    dealii::Utilities::to_string(upper[d] - lower[d]) +
                                    " m) is not a whole number of cells of size " + prm.get("Cell size") + ".");
       }
@@ -477,7 +471,7 @@ namespace mpm
       {
         const long n = std::lround((upper[d] - lower[d]) / cell_size);
         if (n % cells_per_grid_cell != 0)
-          fail("Grid/Cells per deal.II cell",
+          parameter_error("Grid/Cells per deal.II cell",
                "must divide the number of cells along every direction; " + std::string(axis_names[d]) + " has " +
                  std::to_string(n) + " cells, not a multiple of " + std::to_string(cells_per_grid_cell) + ".");
       }
@@ -496,7 +490,7 @@ namespace mpm
     friction_coefficient = prm.get_double("Friction coefficient");
     for (unsigned int id = 0; id < 2 * dim; ++id)
       if (boundary[id] == BoundaryType::friction && !(friction_coefficient > 0))
-        fail("Boundary conditions/Friction coefficient",
+        parameter_error("Boundary conditions/Friction coefficient",
              std::string("must be > 0 where a face is friction (") + axis_names[id / 2] + (id % 2 ? " max" : " min") +
                " is); for a wall without friction set that face to free-slip.");
     prm.leave_subsection();
@@ -514,7 +508,7 @@ namespace mpm
                      shape == "CPDI2q"             ? ShapeFunction::cpdi2q : ShapeFunction::linear;
     const bool cpdi_family = shape_function == ShapeFunction::cpdi || shape_function == ShapeFunction::cpdi2q;
     if (shape_function == ShapeFunction::cpdi2q && dim != 2)
-      fail("Solver/Shape function", "CPDI2q is two-dimensional (its domains are quadrilaterals); in 3D use CPDI, "
+      parameter_error("Solver/Shape function", "CPDI2q is two-dimensional (its domains are quadrilaterals); in 3D use CPDI, "
                                     "whose parallelepipeds follow F.");
     const std::string du = prm.get("GIMP domain update");
     domain_update = du == "det F" ? DomainUpdate::det_F :
@@ -522,27 +516,27 @@ namespace mpm
                     du == "U"     ? DomainUpdate::U : DomainUpdate::none;
     if (shape_function != ShapeFunction::gimp && shape_function != ShapeFunction::bspline3_gimp &&
         domain_update != DomainUpdate::none)
-      fail("Solver/GIMP domain update", "'" + du + "' needs Shape function = GIMP or cubic B-spline GIMP; with "
+      parameter_error("Solver/GIMP domain update", "'" + du + "' needs Shape function = GIMP or cubic B-spline GIMP; with "
                                         "Shape function = " + shape + " the only allowed value is none.");
     if (cpdi_family && active_block_cells > 0)
-      fail("Grid/Nodes", "'near material' keeps the nodes within a fixed number of cells of each point's cell, "
+      parameter_error("Grid/Nodes", "'near material' keeps the nodes within a fixed number of cells of each point's cell, "
                          "but a CPDI domain stretched by the flow reaches farther; with Shape function = " + shape +
                          " the only allowed value is all.");
     if (shape_function == ShapeFunction::bspline3_gimp && active_block_cells == 1)
-      fail("Grid/Active block size", "the cubic B-spline GIMP's stencil reaches two cells out of a point's cell, "
+      parameter_error("Grid/Active block size", "the cubic B-spline GIMP's stencil reaches two cells out of a point's cell, "
                                      "beyond the nodes that blocks of 1 cell keep around it; with Shape function = " +
                                        shape + " and Nodes = near material the allowed values are 2 to 64 "
                                        "(2: the nodes are chosen again whenever a point leaves its cell).");
     adaptive_time_step = prm.get("Time step") == "adaptive";
     cfl                = prm.get_double("CFL number");
     if (!(cfl > 0))
-      fail("Solver/CFL number", "must satisfy 0 < CFL <= 1, got " + prm.get("CFL number") + ".");
+      parameter_error("Solver/CFL number", "must satisfy 0 < CFL <= 1, got " + prm.get("CFL number") + ".");
     fixed_time_step = prm.get_double("Fixed time step");
     if (!adaptive_time_step && !(fixed_time_step > 0))
-      fail("Solver/Fixed time step", "must be > 0 when Time step = fixed.");
+      parameter_error("Solver/Fixed time step", "must be > 0 when Time step = fixed.");
     damping = prm.get_double("Local damping");
     if (!(damping < 1))
-      fail("Solver/Local damping", "must satisfy 0 <= D < 1, got " + prm.get("Local damping") + ".");
+      parameter_error("Solver/Local damping", "must satisfy 0 <= D < 1, got " + prm.get("Local damping") + ".");
     damping_form = prm.get("Local damping form") == "force norm" ? LocalDampingForm::force_norm
                                                                   : LocalDampingForm::per_component;
     damping_threshold = prm.get_double("Local damping threshold");
@@ -553,7 +547,7 @@ namespace mpm
     affine_matrix = transfer == "APIC" ? AffineMatrix::b_d_inverse : AffineMatrix::velocity_gradient;
     if (transfer == "APIC" &&
         (shape_function == ShapeFunction::gimp || shape_function == ShapeFunction::bspline3_gimp || cpdi_family))
-      fail("Solver/Velocity transfer", "APIC needs Shape function = linear, quadratic B-spline or cubic B-spline "
+      parameter_error("Solver/Velocity transfer", "APIC needs Shape function = linear, quadratic B-spline or cubic B-spline "
                                        "(its D_p is constant only for the B-splines; with GIMP or CPDI a D_p "
                                        "computed per point turns singular at the grid's faces); with Shape "
                                        "function = " + shape + " use Velocity transfer = TPIC.");
@@ -563,7 +557,7 @@ namespace mpm
     const std::string method_scene     = prm.get("Method scene");
     const double      method_tolerance = prm.get_double("Method tolerance");
     if (method_auto && !(method_tolerance > 0))
-      fail("Solver/Method tolerance", "must be > 0 with Method = auto, got " + prm.get("Method tolerance") + ".");
+      parameter_error("Solver/Method tolerance", "must be > 0 with Method = auto, got " + prm.get("Method tolerance") + ".");
     gravity           = get_point(prm, "Gravity", "Solver/");
     gravity_ramp_time = prm.get_double("Gravity ramp time");
     max_steps         = prm.get_integer("Maximum number of steps");
@@ -578,7 +572,7 @@ namespace mpm
     for (unsigned int i = 0; i < material_names.size(); ++i)
       for (unsigned int j = 0; j < i; ++j)
         if (material_names[i] == material_names[j])
-          fail("Materials/Names", "the name '" + material_names[i] + "' appears twice.");
+          parameter_error("Materials/Names", "the name '" + material_names[i] + "' appears twice.");
     for (const std::string &name : material_names)
       {
         prm.enter_subsection("Material " + name);
@@ -597,14 +591,14 @@ namespace mpm
             const std::string section = "Material " + name + "/" + model;
             const std::size_t closing = what.find("' ", 7);
             if (what.rfind("Entry '", 0) == 0 && closing != std::string::npos)
-              fail(section + "/" + what.substr(7, closing - 7), what.substr(closing + 2));
-            fail(section, what);
+              parameter_error(section + "/" + what.substr(7, closing - 7), what.substr(closing + 2));
+            parameter_error(section, what);
           }
         prm.leave_subsection();
         if (prm.get("Elastic law") == "Hencky")
           {
             if (materials.back().model == MaterialModel::user_defined)
-              fail("Material " + name + "/Elastic law", "Hencky needs a built-in model (linear elastic, drucker "
+              parameter_error("Material " + name + "/Elastic law", "Hencky needs a built-in model (linear elastic, drucker "
                                                         "prager, mohr coulomb); '" + model + "' is defined outside "
                                                         "the library and gets only strain and spin increments.");
             materials.back().elastic_law = ElasticLaw::hencky;
@@ -612,7 +606,7 @@ namespace mpm
         {
           const double ratio = prm.get_double("Disconnection volume ratio");
           if (ratio != 0 && !(ratio > 1))
-            fail("Material " + name + "/Disconnection volume ratio",
+            parameter_error("Material " + name + "/Disconnection volume ratio",
                  "must be 0 (never) or a ratio of volumes greater than 1; got " + prm.get("Disconnection volume ratio") +
                    ".");
           materials.back().disconnection_volume_ratio = ratio;
@@ -621,12 +615,12 @@ namespace mpm
           {
             const std::vector<StateVariable> variables = user->state_variables();
             if (variables.size() > static_cast<std::size_t>(max_state_variables))
-              fail("Material " + name + "/Model", "the model '" + model + "' declares " +
+              parameter_error("Material " + name + "/Model", "the model '" + model + "' declares " +
                                                     std::to_string(variables.size()) + " state variables; at most " +
                                                     std::to_string(max_state_variables) + " are allowed.");
             for (const StateVariable &v : variables)
               if (v.name.empty() || v.name.find_first_of(" ,") != std::string::npos)
-                fail("Material " + name + "/Model", "the model '" + model + "' declares a state variable named '" +
+                parameter_error("Material " + name + "/Model", "the model '" + model + "' declares a state variable named '" +
                                                       v.name + "'; names must be non-empty, without spaces or commas "
                                                       "(they name output fields).");
           }
@@ -644,18 +638,18 @@ namespace mpm
         material_field_max_clipped.push_back(prm.get_double("Maximum clipped fraction"));
         for (const double L : rf.correlation_length)
           if (!(L > 0))
-            fail(where + "Correlation lengths", "every correlation length must be > 0.");
+            parameter_error(where + "Correlation lengths", "every correlation length must be > 0.");
         const SofteningStrength<double> *strength =
           m.model == MaterialModel::drucker_prager ? &m.drucker_prager.strength :
           m.model == MaterialModel::mohr_coulomb   ? &m.mohr_coulomb.strength :
                                                      nullptr;
         if (field != "none" && m.model == MaterialModel::user_defined)
-          fail(where + "Parameter", "a random field needs a built-in model (linear elastic, drucker prager, mohr "
+          parameter_error(where + "Parameter", "a random field needs a built-in model (linear elastic, drucker prager, mohr "
                                     "coulomb); '" + model + "' is defined outside the library.");
         if (field == "cohesion" || field == "friction angle")
           {
             if (strength == nullptr)
-              fail(where + "Parameter", "'" + field + "' needs a plastic model (drucker prager or mohr coulomb), "
+              parameter_error(where + "Parameter", "'" + field + "' needs a plastic model (drucker prager or mohr coulomb), "
                                         "not '" + model + "'.");
             m.field_parameter = field == "cohesion" ? FieldParameter::cohesion : FieldParameter::friction_angle;
             rf.mean           = field == "cohesion" ? strength->cohesion : strength->friction_angle;
@@ -678,7 +672,7 @@ namespace mpm
     initial_state.parse(prm, material_names, materials);
     prm.leave_subsection();
     if (initial_state.equilibrate && gravity_ramp_time > 0)
-      fail("Initial state/Equilibrate", "the equilibration holds gravity in full; it needs Solver/Gravity ramp "
+      parameter_error("Initial state/Equilibrate", "the equilibration holds gravity in full; it needs Solver/Gravity ramp "
                                         "time = 0 (a ramp after it would take the load off the state).");
 
     prm.enter_subsection("Material points");
@@ -714,20 +708,20 @@ namespace mpm
         prm.leave_subsection();
 
         if (!(body.density > 0))
-          fail(where + "Density", "must be > 0.");
+          parameter_error(where + "Density", "must be > 0.");
         unsigned int material_index = material_names.size();
         for (unsigned int m = 0; m < material_names.size(); ++m)
           if (material_names[m] == body.material)
             material_index = m;
         if (material_index == material_names.size())
-          fail(where + "Material", "'" + body.material + "' is not one of Materials/Names (allowed: " +
+          parameter_error(where + "Material", "'" + body.material + "' is not one of Materials/Names (allowed: " +
                                      join(material_names) + ").");
         if (body.shape == "cylinder" && dim != 3)
-          fail(where + "Shape", "a cylinder (a vertical column) needs Dimension = 3; in 2D use box or polygon.");
+          parameter_error(where + "Shape", "a cylinder (a vertical column) needs Dimension = 3; in 2D use box or polygon.");
         if (body.shape == "cylinder" && !(body.radius > 0))
-          fail(where + "Radius", "a cylinder needs a radius > 0.");
+          parameter_error(where + "Radius", "a cylinder needs a radius > 0.");
         if (body.shape == "polygon" && body.polygon.size() < 3)
-          fail(where + "Polygon vertices", "a polygon needs at least 3 vertices, got " +
+          parameter_error(where + "Polygon vertices", "a polygon needs at least 3 vertices, got " +
                                              std::to_string(body.polygon.size()) + ".");
         if (body.shape == "polygon")
           {
@@ -737,7 +731,7 @@ namespace mpm
               return "from vertex " + std::to_string(e + 1) + " to vertex " + std::to_string((e + 1) % n + 1);
             };
             if (k >= 0)
-              fail(where + "Polygon vertices",
+              parameter_error(where + "Polygon vertices",
                    "the polygon crosses itself: its edge " + edge(k) + " meets the edge " + edge(m) +
                      ". Give the vertices in order around the boundary (either direction), so that no two edges "
                      "cross or overlap.");
@@ -769,11 +763,11 @@ namespace mpm
         for (unsigned int d = 0; d < dim; ++d)
           {
             if (!(hi[d] > lo[d]))
-              fail(where + entry(true), std::string(hi[d] < lo[d] ? "the upper corner lies below the lower one in " :
+              parameter_error(where + entry(true), std::string(hi[d] < lo[d] ? "the upper corner lies below the lower one in " :
                                                                       "the body has no extent in ") +
                                           axis_names[d] + " (" + number(lo[d]) + " to " + number(hi[d]) + ").");
             if (lo[d] < lower[d] - 1e-12 || hi[d] > upper[d] + 1e-12)
-              fail(where + entry(hi[d] > upper[d] + 1e-12),
+              parameter_error(where + entry(hi[d] > upper[d] + 1e-12),
                    std::string("the body reaches outside the grid in ") + axis_names[d] + " ([" + number(lo[d]) +
                      ", " + number(hi[d]) + "] is not inside [" + number(lower[d]) + ", " + number(upper[d]) +
                      "]).");
@@ -813,7 +807,7 @@ namespace mpm
       {
         for (unsigned int i = 0; i < materials.size(); ++i)
           if (materials[i].model == MaterialModel::user_defined)
-            fail("Backend/Precision", "float cannot run material '" + material_names[i] + "': its model '" +
+            parameter_error("Backend/Precision", "float cannot run material '" + material_names[i] + "': its model '" +
                                         material_models[i] + "' is defined outside the library and steps in "
                                         "double; the allowed value is: double.");
       }
@@ -821,7 +815,7 @@ namespace mpm
     if (method_auto)
       {
         if (bodies.empty())
-          fail("Solver/Method", "auto measures the scene's resolution across its bodies (Material points/Body i); "
+          parameter_error("Solver/Method", "auto measures the scene's resolution across its bodies (Material points/Body i); "
                                 "a scene whose points come from a FEM file has none: set the method (Method = as "
                                 "set).");
         double extent = 0;
@@ -844,7 +838,7 @@ namespace mpm
           }
         catch (const std::invalid_argument &e)
           {
-            fail("Solver/Method tolerance", std::string(e.what()) + " Raise the tolerance, refine the grid (Grid/Cell "
+            parameter_error("Solver/Method tolerance", std::string(e.what()) + " Raise the tolerance, refine the grid (Grid/Cell "
                                                                     "size), or set the method (Method = as set).");
           }
         const MethodSettings &m = choice.method;
@@ -862,7 +856,7 @@ namespace mpm
       for (unsigned int i = 0; i < materials.size(); ++i)
         {
           if (materials[i].model == MaterialModel::user_defined)
-            fail("Backend/Backend", "cuda cannot run material '" + material_names[i] + "': its model '" +
+            parameter_error("Backend/Backend", "cuda cannot run material '" + material_names[i] + "': its model '" +
                                       material_models[i] + "' is defined outside the library and runs on the "
                                       "CPU backend only (Backend = cpu).");
         }

@@ -1,4 +1,5 @@
 #include <mpm/run/scene.h>
+#include <mpm/dealii/parameter_error.h>
 
 #include <deal.II/base/exceptions.h>
 
@@ -8,11 +9,6 @@ namespace mpm
 {
   namespace
   {
-    [[noreturn]] void fail(const std::string &entry, const std::string &what)
-    {
-      AssertThrow(false, dealii::ExcMessage("Parameter '" + entry + "': " + what));
-      std::abort();
-    }
 
     // The FEM stage's subsection, read into `settings`, and what it asks of the MPM's entries.
     ParameterSection prefailure_section(fem::PrefailureParameters &settings)
@@ -26,10 +22,10 @@ namespace mpm
         if (settings.analysis == fem::Analysis::none)
           return;
         if (mpm.initial_state.source == "FEM file")
-          fail("Initial state/Source", "the FEM file and a Pre-failure analysis are two initial states; choose one "
+          parameter_error("Initial state/Source", "the FEM file and a Pre-failure analysis are two initial states; choose one "
                                        "(Source = prm bodies, or Pre-failure analysis/Method = none).");
         if (settings.mesh == "mesh file" && mpm.initial_state.materials.empty())
-          fail("Initial state/Materials",
+          parameter_error("Initial state/Materials",
                "Pre-failure analysis/Mesh = mesh file needs at least one 'id: material name, density'.");
       };
       return section;
