@@ -558,7 +558,7 @@ namespace mpm
                            "Disconnection volume ratio, e.g. 2); with either it was stable in every run measured.");
     if (p.plasticity_start_time > p.end_time)
       for (unsigned int m = 0; m < p.materials.size(); ++m)
-        if (p.materials[m].model != MaterialModel::linear_elastic)
+        if (built_in_model_is(p.materials[m].model, [](auto member) { return decltype(member)::plastic; }, true))
           {
             warn_about_parameter("Solver/Plasticity start time",
                                  number(p.plasticity_start_time) + " s is after Solver/End time = " +

@@ -28,6 +28,11 @@ namespace mpm
   {
     const char *axis_names[3] = {"x", "y", "z"};
 
+    // The built-in models' names for messages (material_family.h).
+    const std::string any_built_in_model   = built_in_model_names([](auto) { return true; });
+    const std::string models_with_strength =
+      built_in_model_names([](auto member) { return has_friction_strength<decltype(member)>(); });
+
     std::string zeros(const unsigned int dim, const double last = 0)
     {
       std::string s;
@@ -598,8 +603,7 @@ namespace mpm
         if (prm.get("Elastic law") == "Hencky")
           {
             if (materials.back().model == MaterialModel::user_defined)
-              parameter_error("Material " + name + "/Elastic law", "Hencky needs a built-in model (linear elastic, drucker "
-                                                        "prager, mohr coulomb); '" + model + "' is defined outside "
+              parameter_error("Material " + name + "/Elastic law", "Hencky needs a built-in model (" + any_built_in_model + "); '" + model + "' is defined outside "
                                                         "the library and gets only strain and spin increments.");
             materials.back().elastic_law = ElasticLaw::hencky;
           }
@@ -639,17 +643,17 @@ namespace mpm
         for (const double L : rf.correlation_length)
           if (!(L > 0))
             parameter_error(where + "Correlation lengths", "every correlation length must be > 0.");
-        const SofteningStrength<double> *strength =
-          m.model == MaterialModel::drucker_prager ? &m.drucker_prager.strength :
-          m.model == MaterialModel::mohr_coulomb   ? &m.mohr_coulomb.strength :
-                                                     nullptr;
+        const SofteningStrength<double> *strength = nullptr;
+        with_built_in_model(m.model, [&](auto member) {
+          strength = decltype(member)::strength(parameters_of<decltype(member)>(m));
+        });
         if (field != "none" && m.model == MaterialModel::user_defined)
-          parameter_error(where + "Parameter", "a random field needs a built-in model (linear elastic, drucker prager, mohr "
-                                    "coulomb); '" + model + "' is defined outside the library.");
+          parameter_error(where + "Parameter", "a random field needs a built-in model (" + any_built_in_model + "); '" + model +
+                                                 "' is defined outside the library.");
         if (field == "cohesion" || field == "friction angle")
           {
             if (strength == nullptr)
-              parameter_error(where + "Parameter", "'" + field + "' needs a plastic model (drucker prager or mohr coulomb), "
+              parameter_error(where + "Parameter", "'" + field + "' needs a model with c and phi (" + models_with_strength + "), "
                                         "not '" + model + "'.");
             m.field_parameter = field == "cohesion" ? FieldParameter::cohesion : FieldParameter::friction_angle;
             rf.mean           = field == "cohesion" ? strength->cohesion : strength->friction_angle;

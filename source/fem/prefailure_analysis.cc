@@ -48,14 +48,15 @@ namespace mpm::fem
         std::string elastic;
         bool        any_strength = false;
         for (const auto &[id, m] : fem_materials)
-          if (m.parameters.model == MaterialModel::drucker_prager || m.parameters.model == MaterialModel::mohr_coulomb)
+          if (built_in_model_is(m.parameters.model, [](auto member) { return decltype(member)::plastic; }, false))
             any_strength = true;
           else
             elastic += (elastic.empty() ? "" : ", ") + m.name;
         AssertThrow(any_strength,
                     ExcMessage("Parameter 'Pre-failure analysis/Method': strength reduction divides c and tan(phi), "
-                               "but no material of the mesh has them (" + elastic + ": linear elastic); give one a "
-                               "strength (Materials/Material <name>/Model = drucker prager or mohr coulomb)."));
+                               "but no material of the mesh has a strength (" + elastic + "); give one a "
+                               "strength (Materials/Material <name>/Model = " +
+                               built_in_model_names([](auto member) { return decltype(member)::plastic; }) + ")."));
       }
     quasi_static  = std::make_unique<QuasiStaticSolver<dim>>(triangulation, fem_materials, scene.settings,
                                                             scene.gravity);

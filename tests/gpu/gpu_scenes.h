@@ -111,13 +111,16 @@ namespace mpm_test
   // V3's prm (the flow carries centres through this floor where the wall does not stop them,
   // tests/core/test_wall_friction).
   // disconnection_volume_ratio: the material's (material.h, disconnected points).
-  // mohr_coulomb (with drucker_prager): Mohr-Coulomb with the same strength instead.
+  // plastic_model (with drucker_prager): Mohr-Coulomb with the same strength instead, or the
+  // material family's test member (models/test_von_mises_model.h) with a yield stress of 1.5 kPa,
+  // which the column's base exceeds.
   template <template <int, typename> class Target>
   SceneResult collapse(mpm::HostPoints<2, double> &points, const long n_steps,
                        const mpm::HostPoints<2, double> *initial = nullptr, const bool drucker_prager = false,
                        const bool held = false, const mpm::ElasticLaw law = mpm::ElasticLaw::jaumann_rate,
                        const bool floor_at_face = false, const bool flip_fixed_velocity_change = false,
-                       const double disconnection_volume_ratio = 0, const bool mohr_coulomb = false)
+                       const double              disconnection_volume_ratio = 0,
+                       const mpm::MaterialModel  plastic_model              = mpm::MaterialModel::drucker_prager)
   {
     using namespace mpm;
     const double h = 0.005, rho = 2650, E = 0.84e6, nu = 0.3, g = 9.81;
@@ -161,10 +164,15 @@ namespace mpm_test
         m.model                                   = MaterialModel::drucker_prager;
         m.drucker_prager.strength.friction_angle  = 19.8 * 3.14159265358979323846 / 180;
         m.drucker_prager.strength.residual_friction_angle = m.drucker_prager.strength.friction_angle;
-        if (mohr_coulomb)
+        if (plastic_model == MaterialModel::mohr_coulomb)
           {
             m.model                 = MaterialModel::mohr_coulomb;
             m.mohr_coulomb.strength = m.drucker_prager.strength;
+          }
+        if (plastic_model == MaterialModel::test_von_mises)
+          {
+            m.model                       = MaterialModel::test_von_mises;
+            m.test_von_mises.yield_stress = 1.5e3;
           }
       }
     m.elastic_law                = law;

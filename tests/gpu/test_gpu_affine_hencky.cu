@@ -1,4 +1,5 @@
-// The affine transfers (TPIC, APIC), Hencky's law and Mohr-Coulomb on the GPU against the CPU,
+// The affine transfers (TPIC, APIC), Hencky's law, Mohr-Coulomb and the material family's test member
+// (J2 plasticity) on the GPU against the CPU,
 // per point, FP64: the kernels of the step's DevicePhysics::all variant (step.h), which the
 // device runs only where a run asks for them. Tolerances as in test_gpu_cpu_agreement.cu (its header says why):
 // undamped elastic scenes 1e-10, Drucker-Prager and damped ones max(1e-10, 100x the CPU's own
@@ -115,7 +116,8 @@ int main(int argc, char **argv)
         HostPoints<2, double> cpu, gpu, initial;
         collapse<CpuTarget>(initial, 0, nullptr, true);
         auto run = [&](auto &out, const auto *start) {
-          collapse<CpuTarget>(out, n, start, true, false, ElasticLaw::jaumann_rate, false, false, 0, true);
+          collapse<CpuTarget>(out, n, start, true, false, ElasticLaw::jaumann_rate, false, false, 0,
+                              MaterialModel::mohr_coulomb);
         };
         run(cpu, &initial);
         const Difference spread = cpu_reordering_spread(initial, cpu, 0.005, run);
@@ -128,10 +130,39 @@ int main(int argc, char **argv)
         std::printf("V3: Mohr-Coulomb against Drucker-Prager, stress %.1e of max |sigma|\n", model_difference);
         check(model_difference > 1e3 * std::max(tolerance, 100 * spread.worst()),
               "V3: Mohr-Coulomb's stresses differ from Drucker-Prager's by far more than the agreement's tolerance");
-        collapse<CudaTarget>(gpu, n, &initial, true, false, ElasticLaw::jaumann_rate, false, false, 0, true);
+        collapse<CudaTarget>(gpu, n, &initial, true, false, ElasticLaw::jaumann_rate, false, false, 0,
+                              MaterialModel::mohr_coulomb);
         report<2>("V3 collapse, Mohr-Coulomb (2D)", compare_points(cpu, gpu, 0.005), spread, n, true);
-        collapse<CudaSortedTarget>(gpu, n, &initial, true, false, ElasticLaw::jaumann_rate, false, false, 0, true);
+        collapse<CudaSortedTarget>(gpu, n, &initial, true, false, ElasticLaw::jaumann_rate, false, false, 0,
+                              MaterialModel::mohr_coulomb);
         report<2>("V3 collapse, Mohr-Coulomb, GPU sorted every 7", compare_points(cpu, gpu, 0.005), spread, n, true);
+      }
+      {
+        // V3 with the material family's test member (J2 plasticity, models/test_von_mises_model.h):
+        // a model added by one file and one line runs on the device, in the all variant
+        // (materials_need_all_physics, as DeviceEngine picks it).
+        const long            n = 600;
+        const auto            von_mises = MaterialModel::test_von_mises;
+        HostPoints<2, double> cpu, gpu, initial;
+        collapse<CpuTarget>(initial, 0, nullptr, true);
+        auto run = [&](auto &out, const auto *start) {
+          collapse<CpuTarget>(out, n, start, true, false, ElasticLaw::jaumann_rate, false, false, 0, von_mises);
+        };
+        run(cpu, &initial);
+        const Difference spread  = cpu_reordering_spread(initial, cpu, 0.005, run);
+        const double     yielded = plastic_fraction(cpu);
+        std::printf("V3 test von Mises: %.1f%% of the points have yielded after %ld steps\n", 100 * yielded, n);
+        check(yielded > 0.01, "V3 test von Mises: the scene exercises the plastic return");
+        HostPoints<2, double> drucker_prager;
+        collapse<CpuTarget>(drucker_prager, n, &initial, true);
+        const double model_difference = compare_points(cpu, drucker_prager, 0.005).stress;
+        check(model_difference > 1e3 * std::max(tolerance, 100 * spread.worst()),
+              "V3: the test von Mises' stresses differ from Drucker-Prager's by far more than the tolerance");
+        collapse<CudaTarget>(gpu, n, &initial, true, false, ElasticLaw::jaumann_rate, false, false, 0, von_mises);
+        report<2>("V3 collapse, test von Mises (2D)", compare_points(cpu, gpu, 0.005), spread, n, true);
+        collapse<CudaSortedTarget>(gpu, n, &initial, true, false, ElasticLaw::jaumann_rate, false, false, 0,
+                                   von_mises);
+        report<2>("V3 collapse, test von Mises, GPU sorted every 7", compare_points(cpu, gpu, 0.005), spread, n, true);
       }
       {
         // P1 with ep2-3De's Drucker-Prager and Hencky's law (3D: the eigen-decomposition), 2 cells

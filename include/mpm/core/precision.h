@@ -11,34 +11,17 @@
 namespace mpm
 {
   template <typename To, typename From>
-  SofteningStrength<To> converted(const SofteningStrength<From> &s)
-  {
-    static_assert(sizeof(SofteningStrength<From>) == 7 * sizeof(From), "a field of SofteningStrength is not copied");
-    SofteningStrength<To> r;
-    r.cohesion                  = static_cast<To>(s.cohesion);
-    r.residual_cohesion         = static_cast<To>(s.residual_cohesion);
-    r.softening_modulus         = static_cast<To>(s.softening_modulus);
-    r.friction_angle            = static_cast<To>(s.friction_angle);
-    r.residual_friction_angle   = static_cast<To>(s.residual_friction_angle);
-    r.friction_softening_strain = static_cast<To>(s.friction_softening_strain);
-    r.dilatancy_angle           = static_cast<To>(s.dilatancy_angle);
-    return r;
-  }
-
-  template <typename To, typename From>
   MaterialParameters<To> converted(const MaterialParameters<From> &m)
   {
-    static_assert(sizeof(LinearElasticParameters<From>) == 2 * sizeof(From) &&
-                    sizeof(DruckerPragerParameters<From>) == 8 * sizeof(From) &&
-                    sizeof(MohrCoulombParameters<From>) == 7 * sizeof(From),
-                  "a field of the material parameters is not copied");
+    static_assert(sizeof(LinearElasticParameters<From>) == 2 * sizeof(From), "a field of the elastic part is not copied");
     MaterialParameters<To> r;
     r.model                           = m.model;
     r.elastic.youngs_modulus          = static_cast<To>(m.elastic.youngs_modulus);
     r.elastic.poissons_ratio          = static_cast<To>(m.elastic.poissons_ratio);
-    r.drucker_prager.strength         = converted<To>(m.drucker_prager.strength);
-    r.drucker_prager.tensile_strength = static_cast<To>(m.drucker_prager.tensile_strength);
-    r.mohr_coulomb.strength           = converted<To>(m.mohr_coulomb.strength);
+#define MPM_MATERIAL_CONVERTED(identifier, Member) \
+    r.identifier = Member::template converted<To>(m.identifier);
+    MPM_BUILT_IN_MATERIALS(MPM_MATERIAL_CONVERTED)
+#undef MPM_MATERIAL_CONVERTED
     r.plasticity_enabled              = m.plasticity_enabled;
     r.field_parameter                 = m.field_parameter;
     r.elastic_law                     = m.elastic_law;

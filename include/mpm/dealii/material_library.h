@@ -1,6 +1,7 @@
-// Constitutive models by name. Each built-in model lives in one file under source/dealii/materials/
-// that declares its prm entries, parses them into the core's MaterialParameters and registers
-// itself with MPM_REGISTER_MATERIAL; nothing else needs to change.
+// Constitutive models by name. The built-in models are the core's material family
+// (include/mpm/core/material/material_family.h): each declares its prm section without deal.II
+// (material_entries.h), and material_library.cc registers every one owned by `always` under its
+// name through the adapters below.
 //
 // A user's program adds its own model the same way, from its own file, without touching the
 // library (examples/custom_material):
@@ -22,6 +23,7 @@
 #pragma once
 
 #include <mpm/core/material/material.h>
+#include <mpm/core/material/material_entries.h>
 #include <mpm/core/material/user_model.h>
 
 #include <deal.II/base/parameter_handler.h>
@@ -43,6 +45,35 @@ namespace mpm
   };
 
   std::map<std::string, MaterialPlugin> &material_library();
+
+  // The core's entry interfaces over a ParameterHandler whose subsection is entered.
+  class HandlerEntries : public MaterialEntries
+  {
+  public:
+    explicit HandlerEntries(dealii::ParameterHandler &prm);
+    void real(const std::string &name, const std::string &default_value, double min, double max,
+              const std::string &documentation) override;
+
+  private:
+    dealii::ParameterHandler &prm;
+  };
+
+  class HandlerEntryValues : public MaterialEntryValues
+  {
+  public:
+    explicit HandlerEntryValues(dealii::ParameterHandler &prm);
+    double      real(const std::string &name) const override;
+    std::string as_written(const std::string &name) const override;
+    // Throws ExcMessage("Entry 'name' what").
+    [[noreturn]] void fail(const std::string &name, const std::string &what) const override;
+
+  private:
+    dealii::ParameterHandler &prm;
+  };
+
+  // Adds the built-in members owned by `test` (material_family.h) to the library; a test calls
+  // it before it declares its parameters. Calling it again does nothing.
+  void register_test_materials();
 
   // Adds a model under `name`; a name may be registered once (throws otherwise).
   bool register_material(const std::string &name, const MaterialPlugin &plugin);

@@ -1,5 +1,6 @@
-// prm entries shared by the plastic models: strength (c, phi, psi) and its softening.
-// Angles are read in degrees and handed to the core in radians.
+// prm entries shared by the plastic models, for a model written with a ParameterHandler (a
+// user model, material_library.h): the core's material_entries.h over the handler. Angles are
+// read in degrees and handed to the core in radians.
 #pragma once
 
 #include <mpm/core/material/softening.h>

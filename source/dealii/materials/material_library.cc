@@ -13,6 +13,75 @@ namespace mpm
     return library;
   }
 
+  HandlerEntries::HandlerEntries(dealii::ParameterHandler &prm)
+    : prm(prm)
+  {}
+
+  void HandlerEntries::real(const std::string &name, const std::string &default_value, const double min,
+                            const double max, const std::string &documentation)
+  {
+    prm.declare_entry(name, default_value, dealii::Patterns::Double(min, max), documentation);
+  }
+
+  HandlerEntryValues::HandlerEntryValues(dealii::ParameterHandler &prm)
+    : prm(prm)
+  {}
+
+  double HandlerEntryValues::real(const std::string &name) const
+  {
+    return prm.get_double(name);
+  }
+
+  std::string HandlerEntryValues::as_written(const std::string &name) const
+  {
+    return prm.get(name);
+  }
+
+  void HandlerEntryValues::fail(const std::string &name, const std::string &what) const
+  {
+    AssertThrow(false, dealii::ExcMessage("Entry '" + name + "' " + what));
+    throw; // not reached: AssertThrow throws
+  }
+
+  namespace
+  {
+    // The plugin of built-in member Member: its section, its parameters with the elastic part.
+    template <typename Member>
+    MaterialPlugin built_in_plugin()
+    {
+      return MaterialPlugin{Member::description,
+                            [](dealii::ParameterHandler &prm) {
+                              HandlerEntries entries(prm);
+                              Member::declare(entries);
+                            },
+                            [](dealii::ParameterHandler &prm) {
+                              const HandlerEntryValues   values(prm);
+                              MaterialParameters<double> m{};
+                              m.model                          = tag_of<Member>();
+                              m.elastic                        = parse_elastic_entries(values);
+                              parameters_of<Member>(m)         = Member::parse(values);
+                              return m;
+                            }};
+    }
+
+    void register_built_in(const MaterialOwner owner)
+    {
+      for_each_built_in_model([&](auto member) {
+        using Member = decltype(member);
+        if (Member::owner == owner)
+          register_material(Member::name, built_in_plugin<Member>());
+      });
+    }
+
+    [[maybe_unused]] const bool built_in_registered = (register_built_in(MaterialOwner::always), true);
+  } // namespace
+
+  void register_test_materials()
+  {
+    static const bool registered = (register_built_in(MaterialOwner::test), true);
+    (void)registered;
+  }
+
   bool register_material(const std::string &name, const MaterialPlugin &plugin)
   {
     AssertThrow(!name.empty() && name.find_first_of("|,") == std::string::npos,

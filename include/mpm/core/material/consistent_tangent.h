@@ -76,18 +76,19 @@ namespace mpm
     tangent_detail::elastic_matrix(elastic, C);
   }
 
-  // Drucker-Prager: returns the trial stress (in: trial, out: returned, as drucker_prager_return
-  // gives it) and its tangent C with respect to the strain increment.
-  MPM_HOST_DEVICE inline ReturnResult<double> drucker_prager_tangent(const LinearElasticParameters<double>   &elastic,
-                                                                     const DruckerPragerCoefficients<double> &k,
-                                                                     SymTensor<double> &stress, Tangent C)
+  // A return mapping of the whole Voigt stress, return_mapping(elastic, stress) with both in
+  // Dual<6>: returns the trial stress (in: trial, out: returned, as the mapping gives it) and
+  // its tangent C with respect to the strain increment. Host only (the FEM stage).
+  template <typename ReturnMapping>
+  inline ReturnResult<double> voigt_tangent(const LinearElasticParameters<double> &elastic,
+                                                            SymTensor<double> &stress, Tangent C,
+                                                            ReturnMapping &&return_mapping)
   {
     using D6 = Dual<n_voigt>;
     SymTensor<D6> s;
     for (int c = 0; c < n_voigt; ++c)
       s[c] = D6::variable(stress[c], c);
-    const DruckerPragerCoefficients<D6> kd{k.q_phi, k.k_phi, k.q_psi, k.sigma_t, k.tau_P, k.alpha_P};
-    const ReturnResult<D6> r = drucker_prager_return(tangent_detail::constant<n_voigt>(elastic), kd, s);
+    const ReturnResult<D6> r = return_mapping(tangent_detail::constant<n_voigt>(elastic), s);
     Tangent A;
     for (int i = 0; i < n_voigt; ++i)
       {
@@ -97,6 +98,18 @@ namespace mpm
       }
     tangent_detail::times_elastic(A, elastic, C);
     return {r.mode, {r.multiplier[0].value, r.multiplier[1].value}, r.d_plastic_strain.value};
+  }
+
+  // Drucker-Prager: voigt_tangent of drucker_prager_return.
+  inline ReturnResult<double> drucker_prager_tangent(const LinearElasticParameters<double>   &elastic,
+                                                     const DruckerPragerCoefficients<double> &k,
+                                                     SymTensor<double> &stress, Tangent C)
+  {
+    using D6 = Dual<n_voigt>;
+    const DruckerPragerCoefficients<D6> kd{k.q_phi, k.k_phi, k.q_psi, k.sigma_t, k.tau_P, k.alpha_P};
+    return voigt_tangent(elastic, stress, C, [&](const LinearElasticParameters<D6> &e, SymTensor<D6> &s) {
+      return drucker_prager_return(e, kd, s);
+    });
   }
 
   // Mohr-Coulomb: the same for mohr_coulomb_return.

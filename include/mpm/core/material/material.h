@@ -1,14 +1,11 @@
-// The constitutive models known to the core, dispatched by a model tag so that
-// device code needs no virtual calls. Adding a built-in model: one header with its
-// parameters and MPM_HOST_DEVICE update, one enum value, one case below, and one
-// registration file in the deal.II layer (source/dealii/materials/). A model written outside
-// the library (user_model.h) is the tag user_defined and a pointer; CPU backend only.
+// The constitutive models known to the core, dispatched by a model tag so that device code
+// needs no virtual calls. The built-in models are the material family (material_family.h: one
+// header per model and one line in its list); a model written outside the library
+// (user_model.h) is the tag user_defined and a pointer, CPU backend only.
 #pragma once
 
-#include <mpm/core/material/drucker_prager.h>
 #include <mpm/core/material/hencky.h>
-#include <mpm/core/material/linear_elastic.h>
-#include <mpm/core/material/mohr_coulomb.h>
+#include <mpm/core/material/material_family.h>
 #include <mpm/core/material/user_model.h>
 
 #include <cmath>
@@ -16,14 +13,6 @@
 
 namespace mpm
 {
-  enum class MaterialModel : int
-  {
-    linear_elastic = 0,
-    drucker_prager = 1, // non-associated, tension cut-off, inner fit to Mohr-Coulomb
-    mohr_coulomb   = 2, // non-associated, principal-space return (plane, edge, apex)
-    user_defined   = 3  // UserConstitutiveModel, a virtual call per point (CPU only)
-  };
-
   // A material parameter that varies from point to point (a random field sampled at the
   // points, PointsView::material_field): the point's value replaces the material's.
   enum class FieldParameter : int
@@ -39,9 +28,11 @@ namespace mpm
   {
     MaterialModel                 model;
     LinearElasticParameters<Real> elastic; // every model has an elastic part
-    // Per-model data; only the one of `model` is read.
-    DruckerPragerParameters<Real> drucker_prager;
-    MohrCoulombParameters<Real>   mohr_coulomb;
+    // Per-model data, one member per built-in model named by its identifier (material_family.h);
+    // only the one of `model` is read.
+#define MPM_MATERIAL_PARAMETERS(identifier, Member) typename Member::template Parameters<Real> identifier;
+    MPM_BUILT_IN_MATERIALS(MPM_MATERIAL_PARAMETERS)
+#undef MPM_MATERIAL_PARAMETERS
     // false: plastic models behave elastically (elastic-loading phase before the prm time
     // at which plasticity is switched on); eps_p is then left unchanged.
     bool plasticity_enabled = true;
@@ -56,6 +47,28 @@ namespace mpm
     // model == user_defined: the model (host memory; owned by the material library).
     const UserConstitutiveModel *user_model = nullptr;
   };
+
+  // The parameters of built-in member Member in m (m.identifier).
+  template <typename Member>
+  struct MaterialSlot;
+#define MPM_MATERIAL_SLOT(identifier, Member)                      \
+  template <>                                                      \
+  struct MaterialSlot<Member>                                      \
+  {                                                                \
+    template <typename Material>                                   \
+    MPM_HOST_DEVICE static auto &of(Material &m)                   \
+    {                                                              \
+      return m.identifier;                                         \
+    }                                                              \
+  };
+  MPM_BUILT_IN_MATERIALS(MPM_MATERIAL_SLOT)
+#undef MPM_MATERIAL_SLOT
+
+  template <typename Member, typename Material>
+  MPM_HOST_DEVICE inline auto &parameters_of(Material &m)
+  {
+    return MaterialSlot<Member>::of(m);
+  }
 
   // Per-point state a constitutive update reads and writes.
   template <typename Real>
@@ -90,8 +103,11 @@ namespace mpm
   {
     if (m.field_parameter == FieldParameter::youngs_modulus)
       m.elastic.youngs_modulus = value;
-    set_field_strength(m.drucker_prager.strength, m.field_parameter, value);
-    set_field_strength(m.mohr_coulomb.strength, m.field_parameter, value);
+#define MPM_MATERIAL_FIELD(identifier, Member)                           \
+    if (SofteningStrength<Real> *s = Member::strength(m.identifier))     \
+      set_field_strength(*s, m.field_parameter, value);
+    MPM_BUILT_IN_MATERIALS(MPM_MATERIAL_FIELD)
+#undef MPM_MATERIAL_FIELD
     return m;
   }
 
@@ -105,52 +121,49 @@ namespace mpm
                                                                    m.elastic.p_wave_modulus();
   }
 
-  // The update of a point that knows its whole motion over the step (the MPM step): the
-  // material's elastic law picks the Jaumann rate form or Hencky's. all_laws = false leaves
-  // Hencky's law and Mohr-Coulomb out of the compiled code (the device's standard kernels,
-  // step.h's DevicePhysics): the caller must have made sure no material asks for either
-  // (materials_need_all_physics, step.h); one that does gets a NaN stress, which the step reports.
-  template <bool all_laws = true, typename Real>
-  MPM_HOST_DEVICE inline void update_stress(const MaterialParameters<Real> &m, const StepKinematics<Real> &k,
-                                            MaterialPointState<Real> &state);
+  // Whether the device's standard kernels compile the model of `m` (model_traits.h); the others
+  // run in DevicePhysics::all only (step.h). User models never run on the device.
+  template <typename Real>
+  MPM_HOST_DEVICE inline bool in_standard_kernels(const MaterialParameters<Real> &m)
+  {
+    return built_in_model_is(m.model, [](auto member) { return decltype(member)::in_standard_kernels; }, true);
+  }
 
+  // The update of a point with a strain and spin increment (Jaumann rate form): rotation,
+  // elastic trial, the model's return mapping (explicit softening). all_laws = false leaves the
+  // models outside the standard kernels out of the compiled code (the device's standard
+  // kernels, step.h's DevicePhysics): the caller must have made sure no material asks for one
+  // (materials_need_all_physics, step.h); one that does gets a NaN stress, which the step reports.
   template <bool all_laws = true, typename Real>
   MPM_HOST_DEVICE inline void update_stress(const MaterialParameters<Real> &m,
                                             const SymTensor<Real>          &d_eps,
                                             const Mat3<Real>               &d_spin,
                                             MaterialPointState<Real>       &state)
   {
-    // Every case: Jaumann rotation, elastic trial, then the model's return mapping.
-    switch (m.model)
+    if (m.model == MaterialModel::user_defined)
       {
-        case MaterialModel::drucker_prager:
-          drucker_prager_update(m.elastic, m.drucker_prager, m.plasticity_enabled, d_eps, d_spin, state.stress,
-                                state.plastic_strain);
-          break;
-        case MaterialModel::mohr_coulomb:
-          // Its eigen decomposition (with U's domains) made the standard FP64 kinematics spill:
-          // 614 / 1,024 bytes of spill stores / loads at 96 registers against 142 / 272 without
-          // them (nvcc, 2026-12-05, doc/performance.md); they leave it out.
-          if constexpr (all_laws)
-            mohr_coulomb_update(m.elastic, m.mohr_coulomb, m.plasticity_enabled, d_eps, d_spin, state.stress,
-                                state.plastic_strain);
-          else
-            for (int c = 0; c < n_voigt; ++c)
-              state.stress[c] = Real(NAN);
-          break;
-        case MaterialModel::user_defined:
 #ifndef __CUDA_ARCH__
-          // The interface is double; only the CPU backend runs user models, and it steps in double.
-          if constexpr (std::is_same_v<Real, double>)
-            m.user_model->update_stress(d_eps, d_spin, m.plasticity_enabled, state.stress, state.plastic_strain,
-                                        state.state_variables);
+        // The interface is double; only the CPU backend runs user models, and it steps in double.
+        if constexpr (std::is_same_v<Real, double>)
+          m.user_model->update_stress(d_eps, d_spin, m.plasticity_enabled, state.stress, state.plastic_strain,
+                                      state.state_variables);
 #endif
-          break;
-        case MaterialModel::linear_elastic:
-        default:
-          linear_elastic_update(m.elastic, d_eps, d_spin, state.stress);
-          break;
+        return;
       }
+    with_built_in_model(m.model, [&](auto member) {
+      using Member = decltype(member);
+      if constexpr (all_laws || Member::in_standard_kernels)
+        {
+          const auto &p = parameters_of<Member>(m);
+          elastoplastic_update(m.elastic, Member::plastic && m.plasticity_enabled, d_eps, d_spin, state.stress,
+                               state.plastic_strain, [&](SymTensor<Real> &trial, const Real eps_p) {
+                                 return Member::return_mapping(m.elastic, p, trial, eps_p);
+                               });
+        }
+      else
+        for (int c = 0; c < n_voigt; ++c)
+          state.stress[c] = Real(NAN);
+    });
   }
 
   // A granular point dilated so far that its grains have lost contact (the disconnected phase
@@ -165,7 +178,10 @@ namespace mpm
     return m.disconnection_volume_ratio > Real(0) && J > m.disconnection_volume_ratio;
   }
 
-  template <bool all_laws, typename Real>
+  // The update of a point that knows its whole motion over the step (the MPM step): the
+  // material's elastic law picks the Jaumann rate form or Hencky's. all_laws = false leaves
+  // Hencky's law out of the compiled code as well (see above).
+  template <bool all_laws = true, typename Real>
   MPM_HOST_DEVICE inline void update_stress(const MaterialParameters<Real> &m, const StepKinematics<Real> &k,
                                             MaterialPointState<Real> &state)
   {
@@ -175,34 +191,18 @@ namespace mpm
         return;
       }
     if constexpr (all_laws)
-      {
-        if (m.elastic_law == ElasticLaw::hencky && m.model != MaterialModel::user_defined)
-          {
-            switch (m.model)
-              {
-                case MaterialModel::drucker_prager:
-                  hencky_update(m.elastic, m.plasticity_enabled, k, state.stress, state.plastic_strain,
-                                [&](SymTensor<Real> &tau, const Real eps_p) {
-                                  return drucker_prager_return(m.elastic,
-                                                               drucker_prager_coefficients_at(m.drucker_prager, eps_p),
-                                                               tau);
-                                });
-                  break;
-                case MaterialModel::mohr_coulomb:
-                  hencky_update(m.elastic, m.plasticity_enabled, k, state.stress, state.plastic_strain,
-                                [&](SymTensor<Real> &tau, const Real eps_p) {
-                                  return mohr_coulomb_return(m.elastic, current_strength(m.mohr_coulomb.strength, eps_p),
-                                                             tau);
-                                });
-                  break;
-                default:
-                  hencky_update(m.elastic, false, k, state.stress, state.plastic_strain,
-                                [](SymTensor<Real> &, const Real) { return elastic_return<Real>(); });
-                  break;
-              }
-            return;
-          }
-      }
+      if (m.elastic_law == ElasticLaw::hencky && m.model != MaterialModel::user_defined)
+        {
+          with_built_in_model(m.model, [&](auto member) {
+            using Member = decltype(member);
+            const auto &p = parameters_of<Member>(m);
+            hencky_update(m.elastic, Member::plastic && m.plasticity_enabled, k, state.stress, state.plastic_strain,
+                          [&](SymTensor<Real> &tau, const Real eps_p) {
+                            return Member::return_mapping(m.elastic, p, tau, eps_p);
+                          });
+          });
+          return;
+        }
     update_stress<all_laws>(m, k.d_eps, k.d_spin, state);
   }
 } // namespace mpm

@@ -26,15 +26,11 @@ namespace mpm
     for (int c = 0; c < n_voigt; ++c)
       stress[c] += d_sigma[c];
     ReturnResult<double> r = elastic_return<double>();
-    if (m.plasticity_enabled && m.model == MaterialModel::drucker_prager)
-      {
-        const DruckerPragerCoefficients<double> k =
-          drucker_prager_coefficients(current_strength(m.drucker_prager.strength, plastic_strain),
-                                      m.drucker_prager.tensile_strength);
-        r = drucker_prager_tangent(m.elastic, k, stress, C);
-      }
-    else if (m.plasticity_enabled && m.model == MaterialModel::mohr_coulomb)
-      r = mohr_coulomb_tangent(m.elastic, current_strength(m.mohr_coulomb.strength, plastic_strain), stress, C);
+    if (m.plasticity_enabled)
+      with_built_in_model(m.model, [&](auto member) {
+        using Member = decltype(member);
+        r            = Member::tangent(m.elastic, parameters_of<Member>(m), plastic_strain, stress, C);
+      });
     else
       elastic_tangent(m.elastic, C);
     plastic_strain += r.d_plastic_strain;

@@ -138,4 +138,39 @@ namespace mpm
     plastic_strain += r.d_plastic_strain;
     return r;
   }
+
+  // The strength in another floating-point type (precision.h).
+  template <typename To, typename From>
+  inline SofteningStrength<To> converted(const SofteningStrength<From> &s)
+  {
+    static_assert(sizeof(SofteningStrength<From>) == 7 * sizeof(From), "a field of SofteningStrength is not copied");
+    SofteningStrength<To> r;
+    r.cohesion                  = static_cast<To>(s.cohesion);
+    r.residual_cohesion         = static_cast<To>(s.residual_cohesion);
+    r.softening_modulus         = static_cast<To>(s.softening_modulus);
+    r.friction_angle            = static_cast<To>(s.friction_angle);
+    r.residual_friction_angle   = static_cast<To>(s.residual_friction_angle);
+    r.friction_softening_strain = static_cast<To>(s.friction_softening_strain);
+    r.dilatancy_angle           = static_cast<To>(s.dilatancy_angle);
+    return r;
+  }
+
+  // The strength divided by a strength reduction factor F (strength_reduction.h).
+  template <typename Real>
+  MPM_HOST_DEVICE inline Real reduced_angle(const Real angle, const Real factor)
+  {
+    return std::atan(std::tan(angle) / factor);
+  }
+
+  template <typename Real>
+  MPM_HOST_DEVICE inline SofteningStrength<Real> reduced_strength(SofteningStrength<Real> s, const Real factor)
+  {
+    s.cohesion                = s.cohesion / factor;
+    s.residual_cohesion       = s.residual_cohesion / factor;
+    s.softening_modulus       = s.softening_modulus / factor;
+    s.friction_angle          = reduced_angle(s.friction_angle, factor);
+    s.residual_friction_angle = reduced_angle(s.residual_friction_angle, factor);
+    s.dilatancy_angle         = reduced_angle(s.dilatancy_angle, factor);
+    return s;
+  }
 } // namespace mpm

@@ -143,7 +143,7 @@ namespace mpm
   bool materials_need_all_physics(const Materials &materials)
   {
     for (const auto &m : materials)
-      if (m.elastic_law == ElasticLaw::hencky || m.model == MaterialModel::mohr_coulomb)
+      if (m.elastic_law == ElasticLaw::hencky || !in_standard_kernels(m))
         return true;
     return false;
   }
