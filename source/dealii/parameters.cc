@@ -4,6 +4,7 @@
 #include <mpm/dealii/material_points.h>
 #include <mpm/dealii/method_choice.h>
 #include <mpm/dealii/parameters.h>
+#include <mpm/dealii/prm_reading.h>
 
 #include <deal.II/base/exceptions.h>
 #include <deal.II/base/mpi.h>
@@ -23,111 +24,10 @@ namespace mpm
   using dealii::ExcMessage;
   using dealii::ParameterHandler;
   namespace Patterns = dealii::Patterns;
+  using namespace prm_reading;
 
   namespace
   {
-    const char *axis_names[3] = {"x", "y", "z"};
-
-    // The built-in models' names for messages (material_family.h).
-    const std::string any_built_in_model   = built_in_model_names([](auto) { return true; });
-    const std::string models_with_strength =
-      built_in_model_names([](auto member) { return has_friction_strength<decltype(member)>(); });
-
-    std::string zeros(const unsigned int dim, const double last = 0)
-    {
-      std::string s;
-      for (unsigned int d = 0; d < dim; ++d)
-        s += (d ? ", " : "") + dealii::Utilities::to_string(d + 1 == dim ? last : 0.0);
-      return s;
-    }
-
-    std::string ones(const unsigned int dim)
-    {
-      std::string s;
-      for (unsigned int d = 0; d < dim; ++d)
-        s += d ? ", 1" : "1";
-      return s;
-    }
-
-    Patterns::List point_pattern(const unsigned int dim)
-    {
-      return Patterns::List(Patterns::Double(), dim, dim, ",");
-    }
-
-    // The first two edges of a closed polygon that meet other than at the vertex they share
-    // (edge k runs from vertex k to vertex k + 1, the last back to vertex 0), or {-1, -1}: the
-    // points fill a polygon by the even-odd rule, so a polygon that crosses itself (vertices in
-    // the wrong order) leaves holes where the two sides overlap.
-    std::pair<int, int> crossing_edges(const std::vector<std::array<double, 2>> &v)
-    {
-      const int  n      = static_cast<int>(v.size());
-      const auto orient = [](const std::array<double, 2> &a, const std::array<double, 2> &b,
-                             const std::array<double, 2> &c) {
-        const double cross = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
-        return (cross > 0) - (cross < 0);
-      };
-      const auto on_segment = [](const std::array<double, 2> &a, const std::array<double, 2> &b,
-                                 const std::array<double, 2> &c) { // c on the line ab: within its box?
-        return std::min(a[0], b[0]) <= c[0] && c[0] <= std::max(a[0], b[0]) && std::min(a[1], b[1]) <= c[1] &&
-               c[1] <= std::max(a[1], b[1]);
-      };
-      for (int k = 0; k < n; ++k)
-        for (int m = k + 1; m < n; ++m)
-          {
-            const auto &a = v[k], &b = v[(k + 1) % n], &c = v[m], &d = v[(m + 1) % n];
-            const int   o1 = orient(a, b, c), o2 = orient(a, b, d), o3 = orient(c, d, a), o4 = orient(c, d, b);
-            const bool  adjacent = m == k + 1 || (k == 0 && m == n - 1);
-            if (adjacent)
-              {
-                // Neighbours share a vertex; they overlap only if they fold back along one line.
-                const auto &shared = m == k + 1 ? b : a, &far_k = m == k + 1 ? a : b, &far_m = m == k + 1 ? d : c;
-                if (orient(far_k, shared, far_m) == 0 &&
-                    (far_m[0] - shared[0]) * (far_k[0] - shared[0]) + (far_m[1] - shared[1]) * (far_k[1] - shared[1]) > 0)
-                  return {k, m};
-                continue;
-              }
-            if ((o1 != o2 && o3 != o4) || (o1 == 0 && on_segment(a, b, c)) || (o2 == 0 && on_segment(a, b, d)) ||
-                (o3 == 0 && on_segment(c, d, a)) || (o4 == 0 && on_segment(c, d, b)))
-              return {k, m};
-          }
-      return {-1, -1};
-    }
-
-    // The numbers of a list entry. The pattern has checked their form, but not their range: a
-    // value such as 1e-400 matches Patterns::Double and still does not convert.
-    std::vector<double> to_doubles(const std::string &entry, const std::string &text)
-    {
-      std::vector<double> values;
-      for (const std::string &item : dealii::Utilities::split_string_list(text, ','))
-        {
-          try
-            {
-              values.push_back(dealii::Utilities::string_to_double(item));
-            }
-          catch (...)
-            {
-              parameter_error(entry, "'" + item + "' is not a finite double-precision number (magnitudes from about "
-                          "2.2e-308 to 1.8e308, or 0).");
-            }
-        }
-      return values;
-    }
-
-    // where: the subsection path of the entry, for the message.
-    std::vector<double> get_point(ParameterHandler &prm, const std::string &entry, const std::string &where)
-    {
-      return to_doubles(where + entry, prm.get(entry));
-    }
-
-    std::string join(const std::vector<std::string> &items)
-    {
-      std::string s;
-      for (const std::string &item : items)
-        s += (s.empty() ? "" : ", ") + item;
-      return s;
-    }
-
-
     // Output/Particle fields: each a field of the run's points (PropertyLayout::fields, whose
     // names depend on the dimension and the models' state variables), or id or position.
     template <int dim>
@@ -175,60 +75,7 @@ namespace mpm
   {
     declare_layout(prm);
 
-    prm.enter_subsection("Grid");
-    prm.declare_entry("Lower corner", zeros(dim), point_pattern(dim),
-                      "Lower corner of the background grid, one coordinate per dimension (m).");
-    prm.declare_entry("Upper corner", ones(dim), point_pattern(dim),
-                      "Upper corner of the background grid (m). Each extent must be a multiple of the cell size.");
-    prm.declare_entry("Cell size", "0.1", Patterns::Double(0),
-                      "Edge length h of the square/cubic grid cells (m), the same in every direction.");
-    prm.declare_entry("Nodes", "all", Patterns::Selection("all|near material"),
-                      "Which nodes of the grid the step keeps and updates. all: every node of the box. near "
-                      "material: only those of the blocks of Active block size^dim cells that hold a material "
-                      "point or touch such a block, chosen again whenever a point has moved far enough to need "
-                      "others; cost and memory then follow the material, not the box (the results are the same: "
-                      "bit for bit on the CPU, to round-off on the GPU). The grid files then show only the cells "
-                      "with mass, and on one rank deal.II's grid of the whole box is not built. The kept nodes are "
-                      "numbered as the box around them where that box holds at most twice the kept blocks (no "
-                      "lookup per node: as fast as every node of a box that size), else through a table with "
-                      "one entry per block of nodes (no array over the whole box, so the box can be far larger "
-                      "than the memory its nodes would take). On several ranks (Backend = cpu) deal.II's grid is "
-                      "fine only within two blocks of the points (coarse elsewhere, refined as they spread), the "
-                      "step visits only the kept nodes, and the partition weighs only the cells with points; "
-                      "nothing is kept per cell of the box (about 6 bytes per block). With Backend = cuda on "
-                      "several ranks each rank keeps every node of its part of the grid.");
-    prm.declare_entry("Active block size", "4", Patterns::Integer(1, 64),
-                      "Nodes = near material: edge of the blocks, in cells. Every cell within this many cells "
-                      "of a point's cell is kept; larger blocks choose the nodes less often but keep more. The "
-                      "cubic B-spline GIMP, whose stencil reaches two cells out, needs at least 2.");
-    prm.declare_entry("Cells per deal.II cell", "1", Patterns::Integer(1, 16),
-                      "Edge k of deal.II's cells of the background grid, in cells of Cell size: deal.II's grid has "
-                      "k^dim times fewer cells, and its Q_k elements with equidistant nodes put a degree of "
-                      "freedom at every node of the MPM grid, so the step, its nodes and its results are the "
-                      "same. Building deal.II's grid (on several ranks before the first step) is then much "
-                      "faster, and the partition among ranks moves whole deal.II cells. Each extent of the grid "
-                      "must be a multiple of k cells.");
-    prm.leave_subsection();
-
-    prm.enter_subsection("Boundary conditions");
-    for (unsigned int d = 0; d < dim; ++d)
-      for (const std::string side : {"min", "max"})
-        prm.declare_entry(std::string(axis_names[d]) + " " + side, "free",
-                          Patterns::Selection("free|no-slip|free-slip|friction"),
-                          std::string("Condition on the grid face ") + axis_names[d] + " = " + side +
-                            " (boundary id " + std::to_string(2 * d + (side == std::string("max"))) +
-                            "): free (points that cross it leave the grid and are removed), no-slip (all "
-                            "velocity components zero), free-slip (roller: normal component zero) or friction "
-                            "(a rigid wall with Coulomb friction, coefficient Friction coefficient: where "
-                            "material presses on it, normal component zero and the tangential one braked; where "
-                            "material moves away, nothing). The three walls also stop the points' centres "
-                            "on the face.");
-    prm.declare_entry("Friction coefficient", "0", Patterns::Double(0),
-                      "Coulomb friction coefficient mu of every face set to friction: where material presses "
-                      "on the wall, the tangential velocity of a wall node is reduced by mu times its normal "
-                      "velocity into the wall, to rest at most. Must be > 0 where a face is friction "
-                      "(for a wall without friction use free-slip).");
-    prm.leave_subsection();
+    GridSettings::declare(prm, dim);
 
     prm.enter_subsection("Solver");
     prm.declare_entry("End time", "1", Patterns::Double(0), "Simulated end time (s).");
@@ -336,89 +183,8 @@ namespace mpm
                       "(doc/guards.md).");
     prm.leave_subsection();
 
-    prm.enter_subsection("Materials");
-    prm.leave_subsection();
-    for (const std::string &name : material_names)
-      {
-        prm.enter_subsection("Material " + name);
-        prm.declare_entry("Model", "linear elastic", Patterns::Selection(material_model_names()),
-                          "Constitutive model of this material, one of: " + material_model_names() + ".");
-        prm.declare_entry("Elastic law", "Jaumann rate", Patterns::Selection("Jaumann rate|Hencky"),
-                          "The elastic part of a built-in model at large strain. Jaumann rate: hypoelastic, the "
-                          "stress rotated with the spin plus C : d_eps per step. Hencky: hyperelastic in "
-                          "logarithmic strain (Kirchhoff stress = C : ln V_e), plasticity multiplicative with the "
-                          "model's return mapping in principal logarithmic strains (doc/theory-plasticity.md). The "
-                          "two agree at small strain. Both backends; not with models defined outside the "
-                          "library.");
-        prm.declare_entry("Disconnection volume ratio", "0", Patterns::Double(0),
-                          "A point whose volume exceeds this multiple of its initial volume has lost contact "
-                          "(a granular material's disconnected phase): it carries no stress and takes no part "
-                          "in the pressure averaging, and compacted back below the ratio its stress starts again "
-                          "from zero. Keeps points that a thin front has dilated to many times their volume from "
-                          "taking a recompression's stress on that whole volume (doc/methods.md, \"Disconnected "
-                          "points\"). 0 (the default): never; otherwise a ratio > 1, e.g. 2. The MPM step only "
-                          "(not the FEM stage).");
-        for (const auto &[model, plugin] : material_library())
-          {
-            prm.enter_subsection(model);
-            plugin.declare_parameters(prm);
-            prm.leave_subsection();
-          }
-        prm.enter_subsection("Random field");
-        prm.declare_entry("Parameter", "none", Patterns::Selection("none|cohesion|friction angle|Young's modulus"),
-                          "Material parameter that varies in space as a stationary Gaussian random field sampled at "
-                          "the points; its mean is the value given in the model's subsection (cohesion and friction "
-                          "angle need a plastic model). Cohesion keeps c_res/c, friction angle keeps phi - phi_res.");
-        prm.declare_entry("Covariance", "gaussian", Patterns::Selection("gaussian|exponential"),
-                          "gaussian: C(r) = s^2 exp(-sum (r_d/L_d)^2); exponential: C(r) = s^2 exp(-|r/L|).");
-        prm.declare_entry("Correlation lengths", ones(dim), point_pattern(dim),
-                          "Correlation length L_d along each axis (m, > 0).");
-        prm.declare_entry("Standard deviation", "0", Patterns::Double(0),
-                          "Standard deviation s, in the parameter's prm unit (Pa, degrees).");
-        prm.declare_entry("Seed", "1", Patterns::Integer(0), "Seed of the random numbers (same seed, same field).");
-        prm.declare_entry("Maximum clipped fraction", "0.01", Patterns::Double(0, 1),
-                          "A Gaussian field can fall below zero: values below 1e-3 of the mean are raised to that "
-                          "floor, which shifts the field's mean and distribution. The run is refused when more than "
-                          "this fraction of the material's points are raised (a standard deviation large against "
-                          "the mean: 1% of a Gaussian lies below mean - 2.33 standard deviations).");
-        prm.leave_subsection();
-        prm.leave_subsection();
-      }
-
-    prm.enter_subsection("Material points");
-    for (unsigned int b = 1; b <= n_bodies; ++b)
-      {
-        prm.enter_subsection("Body " + std::to_string(b));
-        prm.declare_entry("Shape", "box", Patterns::Selection("box|polygon|cylinder"),
-                          "box: the points fill [Lower corner, Upper corner]. polygon: the points fill the polygon "
-                          "given by 'Polygon vertices' in the (x, vertical) plane; in 3D it is extruded along y "
-                          "between the y coordinates of Lower and Upper corner. cylinder (3D only): the points of "
-                          "the box [Lower corner, Upper corner] within 'Radius' of the vertical line through "
-                          "'Cylinder axis' (a column, or the quarter of one cut by the box).");
-        prm.declare_entry("Lower corner", zeros(dim), point_pattern(dim), "Lower corner of the box (m).");
-        prm.declare_entry("Upper corner", ones(dim), point_pattern(dim), "Upper corner of the box (m).");
-        prm.declare_entry("Polygon vertices", "",
-                          Patterns::List(Patterns::List(Patterns::Double(), 2, 2, ","), 0,
-                                         Patterns::List::max_int_value, ";"),
-                          "Vertices 'x1, v1; x2, v2; ...' of the polygon (at least 3), v the vertical "
-                          "coordinate (y in 2D, z in 3D).");
-        prm.declare_entry("Cylinder axis", "0, 0", Patterns::List(Patterns::Double(), 2, 2, ","),
-                          "Shape = cylinder: the horizontal coordinates 'x, y' of the cylinder's vertical axis (m).");
-        prm.declare_entry("Radius", "0", Patterns::Double(0), "Shape = cylinder: its radius (m), > 0.");
-        prm.declare_entry("Points per cell direction", "2", Patterns::Integer(1, 10),
-                          "Material points per cell along each direction (2 gives 2x2 in 2D, 2x2x2 in 3D).");
-        prm.declare_entry("Density", "1000", Patterns::Double(0), "Mass density (kg/m^3, > 0).");
-        prm.declare_entry("Initial velocity", zeros(dim), point_pattern(dim), "Initial velocity (m/s).");
-        prm.declare_entry("Material", material_names.front(), Patterns::Anything(),
-                          "Name of this body's material, one of the names in Materials/Names.");
-        prm.declare_entry("Initial stress", "none", Patterns::Selection("none|geostatic"),
-                          "none: stress free. geostatic: vertical stress -|g| times the weight per unit area of "
-                          "the material of all bodies above the point (sum of density x thickness; stacked "
-                          "bodies load the ones below), horizontal stresses K0 of this body times it.");
-        prm.declare_entry("K0", "0.5", Patterns::Double(0), "Lateral earth pressure coefficient for geostatic.");
-        prm.leave_subsection();
-      }
-    prm.leave_subsection();
+    MaterialSettings::declare(prm, dim, material_names);
+    BodySettings::declare(prm, dim, n_bodies, material_names);
 
     prm.enter_subsection("Output");
     OutputSettings::declare(prm);
@@ -454,51 +220,7 @@ namespace mpm
   {
     dim = prm.get_integer("Dimension");
 
-    prm.enter_subsection("Grid");
-    lower     = get_point(prm, "Lower corner", "Grid/");
-    upper     = get_point(prm, "Upper corner", "Grid/");
-    cell_size = prm.get_double("Cell size");
-    if (!(cell_size > 0))
-      parameter_error("Grid/Cell size", "must be > 0, got " + prm.get("Cell size") + ".");
-    for (unsigned int d = 0; d < dim; ++d)
-      {
-        if (!(upper[d] > lower[d]))
-          parameter_error("Grid/Upper corner", std::string("must exceed Lower corner in ") + axis_names[d] + ".");
-        const double n = (upper[d] - lower[d]) / cell_size;
-        if (std::abs(n - std::round(n)) > 1e-8 * std::max(1.0, n))
-          parameter_error("Grid/Cell size", std::string("the extent in ") + axis_names[d] + " (" +
-                                   dealii::Utilities::to_string(upper[d] - lower[d]) +
-                                   " m) is not a whole number of cells of size " + prm.get("Cell size") + ".");
-      }
-    active_block_cells = prm.get("Nodes") == "near material" ? prm.get_integer("Active block size") : 0;
-    cells_per_grid_cell = prm.get_integer("Cells per deal.II cell");
-    for (unsigned int d = 0; d < dim; ++d)
-      {
-        const long n = std::lround((upper[d] - lower[d]) / cell_size);
-        if (n % cells_per_grid_cell != 0)
-          parameter_error("Grid/Cells per deal.II cell",
-               "must divide the number of cells along every direction; " + std::string(axis_names[d]) + " has " +
-                 std::to_string(n) + " cells, not a multiple of " + std::to_string(cells_per_grid_cell) + ".");
-      }
-    prm.leave_subsection();
-
-    prm.enter_subsection("Boundary conditions");
-    for (unsigned int d = 0; d < dim; ++d)
-      for (unsigned int side = 0; side < 2; ++side)
-        {
-          const std::string v = prm.get(std::string(axis_names[d]) + (side ? " max" : " min"));
-          boundary[2 * d + side] = v == "no-slip"   ? BoundaryType::no_slip :
-                                   v == "free-slip" ? BoundaryType::free_slip :
-                                   v == "friction"  ? BoundaryType::friction :
-                                                      BoundaryType::free;
-        }
-    friction_coefficient = prm.get_double("Friction coefficient");
-    for (unsigned int id = 0; id < 2 * dim; ++id)
-      if (boundary[id] == BoundaryType::friction && !(friction_coefficient > 0))
-        parameter_error("Boundary conditions/Friction coefficient",
-             std::string("must be > 0 where a face is friction (") + axis_names[id / 2] + (id % 2 ? " max" : " min") +
-               " is); for a wall without friction set that face to free-slip.");
-    prm.leave_subsection();
+    GridSettings::parse(prm, dim);
 
     prm.enter_subsection("Solver");
     end_time = prm.get_double("End time");
@@ -571,106 +293,7 @@ namespace mpm
     pressure_averaging    = prm.get_bool("Pressure averaging");
     prm.leave_subsection();
 
-    prm.enter_subsection("Materials");
-    material_names = dealii::Utilities::split_string_list(prm.get("Names"), ',');
-    prm.leave_subsection();
-    for (unsigned int i = 0; i < material_names.size(); ++i)
-      for (unsigned int j = 0; j < i; ++j)
-        if (material_names[i] == material_names[j])
-          parameter_error("Materials/Names", "the name '" + material_names[i] + "' appears twice.");
-    for (const std::string &name : material_names)
-      {
-        prm.enter_subsection("Material " + name);
-        const std::string model = prm.get("Model");
-        prm.enter_subsection(model);
-        try
-          {
-            materials.push_back(material_library().at(model).parse_parameters(prm));
-          }
-        catch (const dealii::ExceptionBase &e)
-          {
-            // A model's checks say "Entry 'NAME' what": named here by the entry's whole path.
-            std::ostringstream info;
-            e.print_info(info);
-            const std::string what    = dealii::Utilities::trim(info.str());
-            const std::string section = "Material " + name + "/" + model;
-            const std::size_t closing = what.find("' ", 7);
-            if (what.rfind("Entry '", 0) == 0 && closing != std::string::npos)
-              parameter_error(section + "/" + what.substr(7, closing - 7), what.substr(closing + 2));
-            parameter_error(section, what);
-          }
-        prm.leave_subsection();
-        if (prm.get("Elastic law") == "Hencky")
-          {
-            if (materials.back().model == MaterialModel::user_defined)
-              parameter_error("Material " + name + "/Elastic law", "Hencky needs a built-in model (" + any_built_in_model + "); '" + model + "' is defined outside "
-                                                        "the library and gets only strain and spin increments.");
-            materials.back().elastic_law = ElasticLaw::hencky;
-          }
-        {
-          const double ratio = prm.get_double("Disconnection volume ratio");
-          if (ratio != 0 && !(ratio > 1))
-            parameter_error("Material " + name + "/Disconnection volume ratio",
-                 "must be 0 (never) or a ratio of volumes greater than 1; got " + prm.get("Disconnection volume ratio") +
-                   ".");
-          materials.back().disconnection_volume_ratio = ratio;
-        }
-        if (const UserConstitutiveModel *user = materials.back().user_model)
-          {
-            const std::vector<StateVariable> variables = user->state_variables();
-            if (variables.size() > static_cast<std::size_t>(max_state_variables))
-              parameter_error("Material " + name + "/Model", "the model '" + model + "' declares " +
-                                                    std::to_string(variables.size()) + " state variables; at most " +
-                                                    std::to_string(max_state_variables) + " are allowed.");
-            for (const StateVariable &v : variables)
-              if (v.name.empty() || v.name.find_first_of(" ,") != std::string::npos)
-                parameter_error("Material " + name + "/Model", "the model '" + model + "' declares a state variable named '" +
-                                                      v.name + "'; names must be non-empty, without spaces or commas "
-                                                      "(they name output fields).");
-          }
-
-        // The random field: its mean is the material's own value of the parameter.
-        prm.enter_subsection("Random field");
-        const std::string  field = prm.get("Parameter");
-        const std::string  where = "Material " + name + "/Random field/";
-        MaterialParameters<double> &m = materials.back();
-        RandomFieldParameters       rf;
-        rf.covariance         = prm.get("Covariance") == "exponential" ? Covariance::exponential : Covariance::gaussian;
-        rf.correlation_length = get_point(prm, "Correlation lengths", where);
-        rf.standard_deviation = prm.get_double("Standard deviation");
-        rf.seed               = prm.get_integer("Seed");
-        material_field_max_clipped.push_back(prm.get_double("Maximum clipped fraction"));
-        for (const double L : rf.correlation_length)
-          if (!(L > 0))
-            parameter_error(where + "Correlation lengths", "every correlation length must be > 0.");
-        const SofteningStrength<double> *strength = nullptr;
-        with_built_in_model(m.model, [&](auto member) {
-          strength = decltype(member)::strength(parameters_of<decltype(member)>(m));
-        });
-        if (field != "none" && m.model == MaterialModel::user_defined)
-          parameter_error(where + "Parameter", "a random field needs a built-in model (" + any_built_in_model + "); '" + model +
-                                                 "' is defined outside the library.");
-        if (field == "cohesion" || field == "friction angle")
-          {
-            if (strength == nullptr)
-              parameter_error(where + "Parameter", "'" + field + "' needs a model with c and phi (" + models_with_strength + "), "
-                                        "not '" + model + "'.");
-            m.field_parameter = field == "cohesion" ? FieldParameter::cohesion : FieldParameter::friction_angle;
-            rf.mean           = field == "cohesion" ? strength->cohesion : strength->friction_angle;
-            if (field == "friction angle")
-              rf.standard_deviation *= M_PI / 180;
-          }
-        else if (field == "Young's modulus")
-          {
-            m.field_parameter = FieldParameter::youngs_modulus;
-            rf.mean           = m.elastic.youngs_modulus;
-          }
-        material_fields.push_back(rf);
-        prm.leave_subsection();
-
-        prm.leave_subsection();
-        material_models.push_back(model);
-      }
+    MaterialSettings::parse(prm);
 
     prm.enter_subsection("Initial state");
     initial_state.parse(prm, material_names, materials);
@@ -681,116 +304,8 @@ namespace mpm
 
     prm.enter_subsection("Material points");
     const unsigned int n_bodies = initial_state.source == "FEM file" ? 0 : prm.get_integer("Number of bodies");
-    // The bodies' bounding box (Method = auto measures the resolution across it).
-    std::vector<double> bodies_lo(dim, std::numeric_limits<double>::max()),
-      bodies_hi(dim, std::numeric_limits<double>::lowest());
-    for (unsigned int b = 1; b <= n_bodies; ++b)
-      {
-        const std::string where = "Material points/Body " + std::to_string(b) + "/";
-        prm.enter_subsection("Body " + std::to_string(b));
-        BodyParameters body;
-        body.shape = prm.get("Shape");
-        body.lower = get_point(prm, "Lower corner", where);
-        body.upper = get_point(prm, "Upper corner", where);
-        for (const std::string &vertex :
-             dealii::Utilities::split_string_list(prm.get("Polygon vertices"), ';'))
-          {
-            const auto xy = to_doubles(where + "Polygon vertices", vertex);
-            body.polygon.push_back({{xy[0], xy[1]}});
-          }
-        {
-          const auto axis = to_doubles(where + "Cylinder axis", prm.get("Cylinder axis"));
-          body.axis   = {{axis[0], axis[1]}};
-          body.radius = prm.get_double("Radius");
-        }
-        body.points_per_direction = prm.get_integer("Points per cell direction");
-        body.density              = prm.get_double("Density");
-        body.velocity             = get_point(prm, "Initial velocity", where);
-        body.material             = prm.get("Material");
-        body.initial_stress       = prm.get("Initial stress");
-        body.k0                   = prm.get_double("K0");
-        prm.leave_subsection();
-
-        if (!(body.density > 0))
-          parameter_error(where + "Density", "must be > 0.");
-        unsigned int material_index = material_names.size();
-        for (unsigned int m = 0; m < material_names.size(); ++m)
-          if (material_names[m] == body.material)
-            material_index = m;
-        if (material_index == material_names.size())
-          parameter_error(where + "Material", "'" + body.material + "' is not one of Materials/Names (allowed: " +
-                                     join(material_names) + ").");
-        if (body.shape == "cylinder" && dim != 3)
-          parameter_error(where + "Shape", "a cylinder (a vertical column) needs Dimension = 3; in 2D use box or polygon.");
-        if (body.shape == "cylinder" && !(body.radius > 0))
-          parameter_error(where + "Radius", "a cylinder needs a radius > 0.");
-        if (body.shape == "polygon" && body.polygon.size() < 3)
-          parameter_error(where + "Polygon vertices", "a polygon needs at least 3 vertices, got " +
-                                             std::to_string(body.polygon.size()) + ".");
-        if (body.shape == "polygon")
-          {
-            const auto [k, m] = crossing_edges(body.polygon);
-            const int n = static_cast<int>(body.polygon.size());
-            const auto edge = [n](const int e) {
-              return "from vertex " + std::to_string(e + 1) + " to vertex " + std::to_string((e + 1) % n + 1);
-            };
-            if (k >= 0)
-              parameter_error(where + "Polygon vertices",
-                   "the polygon crosses itself: its edge " + edge(k) + " meets the edge " + edge(m) +
-                     ". Give the vertices in order around the boundary (either direction), so that no two edges "
-                     "cross or overlap.");
-          }
-        // The body must lie inside the grid: a point outside could never be used.
-        std::vector<double> lo = body.lower, hi = body.upper;
-        if (body.shape == "polygon")
-          {
-            lo[0] = hi[0] = body.polygon[0][0];
-            lo[dim - 1] = hi[dim - 1] = body.polygon[0][1];
-            for (const auto &v : body.polygon)
-              {
-                lo[0]       = std::min(lo[0], v[0]);
-                hi[0]       = std::max(hi[0], v[0]);
-                lo[dim - 1] = std::min(lo[dim - 1], v[1]);
-                hi[dim - 1] = std::max(hi[dim - 1], v[1]);
-              }
-          }
-        // The entry at fault: a polygon's vertices, or the box corner on the side that is wrong.
-        const auto entry = [&body](const bool upper_side) {
-          return body.shape == "polygon" ? std::string("Polygon vertices") :
-                                           std::string(upper_side ? "Upper corner" : "Lower corner");
-        };
-        const auto number = [](const double x) { // 0.6, not 0.59999999999999998
-          std::ostringstream out;
-          out << std::setprecision(12) << x;
-          return out.str();
-        };
-        for (unsigned int d = 0; d < dim; ++d)
-          {
-            if (!(hi[d] > lo[d]))
-              parameter_error(where + entry(true), std::string(hi[d] < lo[d] ? "the upper corner lies below the lower one in " :
-                                                                      "the body has no extent in ") +
-                                          axis_names[d] + " (" + number(lo[d]) + " to " + number(hi[d]) + ").");
-            if (lo[d] < lower[d] - 1e-12 || hi[d] > upper[d] + 1e-12)
-              parameter_error(where + entry(hi[d] > upper[d] + 1e-12),
-                   std::string("the body reaches outside the grid in ") + axis_names[d] + " ([" + number(lo[d]) +
-                     ", " + number(hi[d]) + "] is not inside [" + number(lower[d]) + ", " + number(upper[d]) +
-                     "]).");
-          }
-        if (body.shape == "cylinder")
-          for (unsigned int d = 0; d < 2; ++d)
-            {
-              lo[d] = body.axis[d] - body.radius;
-              hi[d] = body.axis[d] + body.radius;
-            }
-        for (unsigned int d = 0; d < dim; ++d)
-          {
-            bodies_lo[d] = std::min(bodies_lo[d], lo[d]);
-            bodies_hi[d] = std::max(bodies_hi[d], hi[d]);
-          }
-        bodies.push_back(body);
-        body_material.push_back(material_index);
-      }
     prm.leave_subsection();
+    BodySettings::parse(prm, dim, n_bodies, material_names, lower, upper);
 
     prm.enter_subsection("Output");
     output.parse(prm);

@@ -14,8 +14,8 @@
 
 namespace mpm
 {
-  // Whether an owner of point arrays holds state variables (HostPoints does; the CUDA
-  // backend's DevicePoints does not: user models, the only ones with any, run on the CPU).
+  // Whether an owner of point arrays holds state variables (HostPoints and the CUDA backend's
+  // DevicePoints do: a user model's own on the CPU, the affine matrices and CPDI's corners on both).
   template <typename Storage, typename = void>
   struct has_state_variables : std::false_type
   {};

@@ -8,8 +8,11 @@
 #include <mpm/core/shape_functions.h>
 #include <mpm/core/step/settings.h>
 #include <mpm/dealii/backend_settings.h>
+#include <mpm/dealii/body_settings.h>
 #include <mpm/dealii/checkpoint_settings.h>
+#include <mpm/dealii/grid_settings.h>
 #include <mpm/dealii/initial_state_settings.h>
+#include <mpm/dealii/material_settings.h>
 #include <mpm/dealii/output_settings.h>
 #include <mpm/dealii/parallel_settings.h>
 #include <mpm/fields/gaussian_random_field.h>
@@ -24,40 +27,12 @@
 
 namespace mpm
 {
-  enum class BoundaryType
-  {
-    free,      // no constraint
-    no_slip,   // every velocity component zero
-    free_slip, // normal velocity component zero (roller)
-    friction   // rigid wall with Coulomb friction, unilateral contact (wall_friction.h)
-  };
-
-  struct BodyParameters
-  {
-    std::string                        shape; // box | polygon | cylinder
-    std::vector<double>                lower, upper;
-    std::vector<std::array<double, 2>> polygon; // (horizontal, vertical) pairs
-    std::array<double, 2>              axis{};  // cylinder: (x, y) of its vertical axis
-    double                             radius = 0;
-    unsigned int                       points_per_direction;
-    double                             density;
-    std::vector<double>                velocity;
-    std::string                        material;
-    std::string                        initial_stress; // none | geostatic
-    double                             k0;
-  };
-
-  struct Parameters
+  // The run's settings. Grid (with Boundary conditions), Materials and the bodies of Material points
+  // are components that declare and parse their own subsections (grid_settings.h,
+  // material_settings.h, body_settings.h); a part that needs only one takes that component.
+  struct Parameters : GridSettings, MaterialSettings, BodySettings
   {
     unsigned int dim = 2;
-
-    // Grid
-    std::vector<double> lower, upper;
-    double              cell_size;
-    int                 active_block_cells = 0; // Nodes = near material: block edge in cells; 0: all nodes
-    int                 cells_per_grid_cell = 1; // edge of deal.II's cells in MPM cells
-    std::array<BoundaryType, 6> boundary{}; // by boundary id: x min, x max, y min, y max, z min, z max
-    double                      friction_coefficient = 0; // mu of every face of type friction
 
     // Solver
     double       end_time;
@@ -85,19 +60,6 @@ namespace mpm
     bool         pressure_averaging; // cell-wise volume-weighted pressure averaging
     unsigned int max_steps;
     double       max_predicted_steps = 1e9; // refuse a first time step predicting more (guards.h)
-
-    // Materials, in the order of their names; bodies refer to them by index.
-    std::vector<std::string>                material_names;
-    std::vector<std::string>                material_models;
-    std::vector<MaterialParameters<double>> materials;
-    // Random field of the parameter named by materials[m].field_parameter (core units:
-    // Pa, rad), mean = the material's own value.
-    std::vector<RandomFieldParameters>      material_fields;
-    // Per material: the largest fraction of its points whose field value may be raised to
-    // the floor (1e-3 of the mean) before the run is refused (Random field/Maximum clipped fraction).
-    std::vector<double>                     material_field_max_clipped;
-    std::vector<BodyParameters>             bodies;
-    std::vector<unsigned int>               body_material; // index into materials
 
     OutputSettings output; // Output
 
