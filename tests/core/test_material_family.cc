@@ -148,7 +148,8 @@ int main()
   {
     const std::string names = built_in_model_names([](auto) { return true; });
     std::printf("built-in models a user sees: %s\n", names.c_str());
-    check(names == "linear elastic, drucker prager or mohr coulomb", "the test member is not among the user's models");
+    check(names.find("test von mises") == std::string::npos && names.find("drucker prager") != std::string::npos,
+          "the test member is not among the user's models (the built-in ones are)");
   }
 
   if (mpm_test::failures() > 0)

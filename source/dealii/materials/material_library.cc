@@ -2,6 +2,7 @@
 
 #include <deal.II/base/exceptions.h>
 
+#include <cstdlib>
 #include <mutex>
 #include <vector>
 
@@ -40,7 +41,7 @@ namespace mpm
   void HandlerEntryValues::fail(const std::string &name, const std::string &what) const
   {
     AssertThrow(false, dealii::ExcMessage("Entry '" + name + "' " + what));
-    throw; // not reached: AssertThrow throws
+    std::abort(); // not reached: AssertThrow throws
   }
 
   namespace
