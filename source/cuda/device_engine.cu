@@ -1168,16 +1168,9 @@ namespace mpm
           const long         *home  = split ? impl->home_cells.data() : nullptr;
           const std::uint8_t *cells = split ? impl->cells_before_overlap.data() : nullptr;
           int                 first = -1;
-          if (impl->shape == ShapeFunction::gimp)
-            first = impl->order.template sort<GimpShape>(impl->backend, g, impl->points, home, cells);
-          else if (impl->shape == ShapeFunction::bspline2)
-            first = impl->order.template sort<QuadraticBSplineShape>(impl->backend, g, impl->points, home, cells);
-          else if (impl->shape == ShapeFunction::bspline3)
-            first = impl->order.template sort<CubicBSplineShape>(impl->backend, g, impl->points, home, cells);
-          else if (impl->shape == ShapeFunction::bspline3_gimp)
-            first = impl->order.template sort<CubicBSplineGimpShape>(impl->backend, g, impl->points, home, cells);
-          else
-            first = impl->order.template sort<LinearShape>(impl->backend, g, impl->points, home, cells);
+          with_shape(impl->shape, [&](auto member) { // CPDI: by the point's cell (cuda_point_order.h)
+            first = impl->order.template sort<decltype(member)>(impl->backend, g, impl->points, home, cells);
+          });
           impl->home_by_slot_stale    = true;
           impl->exchange.first_points = first;
           if (first >= 0 && impl->points.size() > 0)
@@ -1204,7 +1197,8 @@ namespace mpm
       if (s.affine_state_variable >= 0 && impl->points.n_state_variables() < s.affine_state_variable + dim * dim)
         throw std::invalid_argument("DeviceEngine::step: the affine transfers need the points uploaded with their "
                                     "affine matrices (dim x dim state variables)");
-      const bool all_physics = impl->all_laws || settings_need_all_physics(s);
+      const bool all_physics =
+        impl->all_laws || settings_need_all_physics(s) || shape_needs_all_physics(impl->shape);
       const StepReduction<Real> r =
         all_physics ? explicit_step<dim, DevicePhysics::all>(impl->backend, impl->shape, g, impl->points.view(),
                                                               impl->materials.data(), s, dt, impl->exchange,

@@ -68,6 +68,30 @@ namespace mpm
                         "Number of bodies of material points; each has a subsection 'Body <i>', i = 1..n.");
       prm.leave_subsection();
     }
+
+    bool test_shapes_registered = false;
+
+    std::string shape_pattern()
+    {
+      std::string pattern;
+      for (const std::string &name : shape_names(test_shapes_registered, [](auto) { return true; }))
+        pattern += (pattern.empty() ? "" : "|") + name;
+      return pattern;
+    }
+
+    // Each member's name and clause, then what the one-rank members need.
+    std::string shape_documentation()
+    {
+      std::vector<std::string> clauses;
+      for_each_shape([&](ShapeFunction, auto member) {
+        using Member = decltype(member);
+        if (Member::owner == ShapeOwner::always || test_shapes_registered)
+          clauses.push_back(std::string(Member::name) + " (" + Member::description + ")");
+      });
+      return "Grid shape functions: " + join_or(clauses) +
+             ". CPDI and CPDI2q: one MPI rank, Grid/Nodes = all. Cubic B-spline GIMP: one MPI rank; "
+             "Grid/Nodes = near material needs Active block size >= 2.";
+    }
   } // namespace
 
   void Parameters::declare(ParameterHandler &prm, const unsigned int dim, const unsigned int n_bodies,
@@ -81,21 +105,7 @@ namespace mpm
     prm.declare_entry("End time", "1", Patterns::Double(0), "Simulated end time (s).");
     prm.declare_entry("Update scheme", "MUSL", Patterns::Selection("MUSL|USL|USF"),
                       "Explicit update scheme: MUSL (modified update stress last, default), USL or USF.");
-    prm.declare_entry("Shape function", "GIMP",
-                      Patterns::Selection("linear|GIMP|quadratic B-spline|cubic B-spline|cubic B-spline GIMP|CPDI|"
-                                          "CPDI2q"),
-                      "Grid shape functions: linear (standard MPM), GIMP (generalised interpolation), "
-                      "quadratic B-spline (C1, three nodes per direction; within half a cell of the grid's "
-                      "faces it becomes linear, doc/theory.md), cubic B-spline (C2, four nodes per direction, "
-                      "the same treatment at the faces; in MPI runs the points are re-sorted whenever one "
-                      "leaves its cell), cubic B-spline GIMP (the cubic B-spline averaged over each point's "
-                      "axis-aligned domain, five nodes per direction; with GIMP domain update = F_ii, det F or U "
-                      "the domains follow the deformation), CPDI (the linear hats averaged over each point's "
-                      "parallelogram or "
-                      "parallelepiped domain, whose edges follow F, including its rotation and shear) or CPDI2q "
-                      "(2D: the same over a quadrilateral whose four corners move with the grid's velocity). "
-                      "CPDI and CPDI2q: one MPI rank, Grid/Nodes = all. Cubic B-spline GIMP: one MPI rank; "
-                      "Grid/Nodes = near material needs Active block size >= 2.");
+    prm.declare_entry("Shape function", "GIMP", Patterns::Selection(shape_pattern()), shape_documentation());
     prm.declare_entry("GIMP domain update", "none", Patterns::Selection("none|det F|F_ii|U"),
                       "How GIMP particle domains follow the deformation: none (uGIMP), det F (cpGIMP, "
                       "half-lengths scaled by det(F)^(1/dim)), F_ii (cpGIMP, half-length i scaled by F_ii; exact "
@@ -216,6 +226,16 @@ namespace mpm
     prm.leave_subsection();
   }
 
+  void register_test_shapes()
+  {
+    test_shapes_registered = true;
+  }
+
+  bool Parameters::tracks_corners() const
+  {
+    return shape_is(shape_function, [](auto member) { return decltype(member)::tracks_corners; });
+  }
+
   void Parameters::parse(ParameterHandler &prm)
   {
     dim = prm.get_integer("Dimension");
@@ -227,12 +247,10 @@ namespace mpm
     const std::string s = prm.get("Update scheme");
     scheme = s == "USL" ? UpdateScheme::usl : (s == "USF" ? UpdateScheme::usf : UpdateScheme::musl);
     const std::string shape = prm.get("Shape function");
-    shape_function = shape == "GIMP"               ? ShapeFunction::gimp :
-                     shape == "quadratic B-spline" ? ShapeFunction::bspline2 :
-                     shape == "cubic B-spline"     ? ShapeFunction::bspline3 :
-                     shape == "cubic B-spline GIMP" ? ShapeFunction::bspline3_gimp :
-                     shape == "CPDI"               ? ShapeFunction::cpdi :
-                     shape == "CPDI2q"             ? ShapeFunction::cpdi2q : ShapeFunction::linear;
+    for_each_shape([&](const ShapeFunction tag, auto member) {
+      if (shape == decltype(member)::name)
+        shape_function = tag;
+    });
     const bool cpdi_family = shape_function == ShapeFunction::cpdi || shape_function == ShapeFunction::cpdi2q;
     if (shape_function == ShapeFunction::cpdi2q && dim != 2)
       parameter_error("Solver/Shape function", "CPDI2q is two-dimensional (its domains are quadrilaterals); in 3D use CPDI, "
@@ -241,9 +259,12 @@ namespace mpm
     domain_update = du == "det F" ? DomainUpdate::det_F :
                     du == "F_ii"  ? DomainUpdate::stretch :
                     du == "U"     ? DomainUpdate::U : DomainUpdate::none;
-    if (shape_function != ShapeFunction::gimp && shape_function != ShapeFunction::bspline3_gimp &&
+    if (!shape_is(shape_function, [](auto member) { return decltype(member)::point_domain; }) &&
         domain_update != DomainUpdate::none)
-      parameter_error("Solver/GIMP domain update", "'" + du + "' needs Shape function = GIMP or cubic B-spline GIMP; with "
+      parameter_error("Solver/GIMP domain update", "'" + du + "' needs Shape function = " +
+                                        join_or(shape_names(test_shapes_registered, [](auto member) {
+                                          return decltype(member)::point_domain;
+                                        })) + "; with "
                                         "Shape function = " + shape + " the only allowed value is none.");
     if (cpdi_family && active_block_cells > 0)
       parameter_error("Grid/Nodes", "'near material' keeps the nodes within a fixed number of cells of each point's cell, "
@@ -272,9 +293,10 @@ namespace mpm
     const std::string transfer = prm.get("Velocity transfer");
     apic                       = transfer == "APIC" || transfer == "TPIC";
     affine_matrix = transfer == "APIC" ? AffineMatrix::b_d_inverse : AffineMatrix::velocity_gradient;
-    if (transfer == "APIC" &&
-        (shape_function == ShapeFunction::gimp || shape_function == ShapeFunction::bspline3_gimp || cpdi_family))
-      parameter_error("Solver/Velocity transfer", "APIC needs Shape function = linear, quadratic B-spline or cubic B-spline "
+    if (transfer == "APIC" && !shape_is(shape_function, [](auto member) { return decltype(member)::apic; }))
+      parameter_error("Solver/Velocity transfer", "APIC needs Shape function = " +
+                                       join_or(shape_names(false, [](auto member) { return decltype(member)::apic; })) +
+                                       " "
                                        "(its D_p is constant only for the B-splines; with GIMP or CPDI a D_p "
                                        "computed per point turns singular at the grid's faces); with Shape "
                                        "function = " + shape + " use Velocity transfer = TPIC.");
@@ -404,7 +426,7 @@ namespace mpm
       for (unsigned int a = 0; a < dim; ++a)
         for (unsigned int b = 0; b < dim; ++b)
           names.push_back(std::string("apic_C_") + "xyz"[a] + "xyz"[b]);
-    if (shape_function == ShapeFunction::cpdi2q) // CPDI2q's corners, last (corner_state_variable())
+    if (tracks_corners()) // CPDI2q's corners, last (corner_state_variable())
       for (unsigned int c = 0; c < 4; ++c)
         for (unsigned int d = 0; d < dim; ++d)
           names.push_back("cpdi2q_corner" + std::to_string(c + 1) + "_d" + "xyz"[d]);
@@ -413,13 +435,13 @@ namespace mpm
 
   int Parameters::affine_state_variable() const
   {
-    const int corners = shape_function == ShapeFunction::cpdi2q ? 4 * static_cast<int>(dim) : 0;
+    const int corners = tracks_corners() ? 4 * static_cast<int>(dim) : 0;
     return apic ? static_cast<int>(state_variable_names().size()) - static_cast<int>(dim * dim) - corners : -1;
   }
 
   int Parameters::corner_state_variable() const
   {
-    return shape_function == ShapeFunction::cpdi2q ? static_cast<int>(state_variable_names().size()) - 4 * dim : -1;
+    return tracks_corners() ? static_cast<int>(state_variable_names().size()) - 4 * dim : -1;
   }
 
   std::vector<double> Parameters::initial_state_variables(const unsigned int material) const

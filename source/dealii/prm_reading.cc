@@ -63,5 +63,26 @@ namespace mpm
         s += (s.empty() ? "" : ", ") + item;
       return s;
     }
+
+    namespace
+    {
+      std::string join_with_last(const std::vector<std::string> &items, const std::string &last)
+      {
+        std::string s;
+        for (std::size_t k = 0; k < items.size(); ++k)
+          s += (k == 0 ? "" : (k + 1 == items.size() ? last : ", ")) + items[k];
+        return s;
+      }
+    } // namespace
+
+    std::string join_or(const std::vector<std::string> &items)
+    {
+      return join_with_last(items, " or ");
+    }
+
+    std::string join_and(const std::vector<std::string> &items)
+    {
+      return join_with_last(items, " and ");
+    }
   } // namespace prm_reading
 } // namespace mpm

@@ -1,5 +1,7 @@
 #include "simulator_state.h"
 
+#include <mpm/dealii/prm_reading.h>
+
 namespace mpm
 {
   template <int dim>
@@ -10,14 +12,14 @@ namespace mpm
     // A rank holds the nodes of its cells and one ring of ghost cells; a CPDI domain
     // stretched by the flow, and the cubic B-spline GIMP's stencil (two cells out of a
     // point's cell), reach beyond that ring, where their weights would be lost.
-    AssertThrow((parameters.shape_function != ShapeFunction::cpdi &&
-                 parameters.shape_function != ShapeFunction::cpdi2q &&
-                 parameters.shape_function != ShapeFunction::bspline3_gimp) ||
+    const auto one_rank_only = [](auto member) { return runs_on_one_rank_only<decltype(member)>(); };
+    const auto on_any_ranks  = [](auto member) { return !runs_on_one_rank_only<decltype(member)>(); };
+    AssertThrow(!shape_is(parameters.shape_function, one_rank_only) ||
                   dealii::Utilities::MPI::n_mpi_processes(communicator) == 1,
-                dealii::ExcMessage("Parameter 'Solver/Shape function': cubic B-spline GIMP, CPDI and CPDI2q run on "
-                                   "one MPI rank (their stencils reach beyond the ghost cells of a rank's part of "
-                                   "the grid); run this "
-                                   "scene on one rank, or with linear, GIMP, quadratic B-spline or cubic B-spline on " +
+                dealii::ExcMessage("Parameter 'Solver/Shape function': " + prm_reading::join_and(shape_names(false, one_rank_only)) +
+                                   " run on one MPI rank (their stencils reach beyond the ghost cells of a rank's "
+                                   "part of the grid); run this scene on one rank, or with " +
+                                   prm_reading::join_or(shape_names(false, on_any_ranks)) + " on " +
                                    std::to_string(dealii::Utilities::MPI::n_mpi_processes(communicator)) +
                                    " ranks."));
   }

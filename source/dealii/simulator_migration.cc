@@ -81,8 +81,11 @@ namespace mpm
                                                 std::min(engine->active_node_margin(), parameters.active_block_cells - 1.0) :
                                                 engine->active_node_margin();
     else
-      migration.resort_at = std::min(parameters.parallel.resort_distance * safe_distance_outside_home_cell(parameters.shape_function),
-                           parameters.pressure_averaging ? 0.5 : 1e300);
+      {
+        migration.resort_at   = std::min(parameters.parallel.resort_distance * safe_distance_outside_home_cell(parameters.shape_function),
+                                         parameters.pressure_averaging ? 0.5 : 1e300);
+        migration.ghost_width = parameters.cells_per_grid_cell;
+      }
   }
 
   template <int dim>

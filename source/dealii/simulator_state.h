@@ -175,6 +175,12 @@ namespace mpm
     struct Migration
     {
       double resort_at = 1e300; // re-sort (or choose the nodes again) once a point is farther out than this
+      // Several ranks: the ghost layer's width in cells (one deal.II cell). The re-sort finds a
+      // point's new cell only among its rank's owned and ghost cells, so the points are re-sorted
+      // before one could end the next step beyond it (next_step: this step's displacement, the
+      // estimate of the next one's), whatever resort_at allows.
+      double ghost_width = 1e300;
+      double next_step   = 0;
       // Several ranks: a bound on the distance of any point outside its home cell (cells): the
       // largest distance at the last check (0 after a re-sort) plus step_displacement_bound of
       // every step since; the points are checked only once it exceeds resort_at (n_home_checks
@@ -399,7 +405,7 @@ namespace mpm
                                          " cells outside the cell it was sorted into, beyond the ghost cells "
                                          "whose pressure sums are exchanged between ranks. Reduce 'Solver/CFL "
                                          "number' or the time step."));
-          if (distance > migration.resort_at)
+          if (resort_needed(distance))
             {
               bool refined;
               {
@@ -425,7 +431,7 @@ namespace mpm
                                          "chosen, beyond the kept cells whose pressure sums the step used (Grid/"
                                          "Active block size = " + std::to_string(parameters.active_block_cells) +
                                          "). Reduce 'Solver/CFL number' or the time step, or enlarge the blocks."));
-          if (distance > migration.resort_at)
+          if (resort_needed(distance))
             {
               engine->refresh_active_nodes();
               ++migration.n_node_refreshes;
@@ -498,6 +504,12 @@ namespace mpm
     // all of this rank's (one rank) or those in its cells (several).
     void start_from(const PointSnapshot<dim> &saved);
 
+    // Whether a point this far out of its home cell is to be re-sorted (or the nodes chosen again).
+    bool resort_needed(const double distance) const
+    {
+      return distance > migration.resort_at || distance + migration.next_step >= migration.ghost_width;
+    }
+
     // The MPI re-sort, counting the points it drops (those that left the grid): they must be
     // the ones the engine held as removed.
     void resort();
@@ -512,8 +524,10 @@ namespace mpm
     double distance_outside_home_cells(const double dt, const When &when)
     {
       migration.drift_bound += step_displacement_bound(dt);
+      migration.next_step = dt * std::max(max_speed, max_removed_speed) / h;
       double     distance = migration.drift_bound;
-      const bool needed   = !(migration.drift_bound <= migration.resort_at);
+      const bool needed   = !(migration.drift_bound <= migration.resort_at) ||
+                          migration.drift_bound + migration.next_step >= migration.ghost_width;
       if (needed || migration.verify_drift_bound)
         {
           distance = global_max(engine->max_distance_outside_home_cells());

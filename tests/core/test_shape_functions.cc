@@ -5,6 +5,7 @@
 #include <mpm/core/cubic_bspline_gimp.h>
 #include <mpm/core/host_storage.h>
 #include <mpm/core/interpolation.h>
+#include <mpm/core/shape/test_wide_linear_shape.h>
 #include <mpm/core/shape_functions.h>
 
 #include "check.h"
@@ -126,6 +127,34 @@ int main()
   // as much per direction: the bound 1e-13; measured 1.4e-14.
   check_family<2, CubicBSplineGimpShape>("cubic B-spline GIMP", rng, false, 1e-13);
   check_family<3, CubicBSplineGimpShape>("cubic B-spline GIMP", rng, false, 1e-13);
+  check_family<2, TestWideLinearShape>("test wide linear", rng, true);
+  check_family<3, TestWideLinearShape>("test wide linear", rng, true);
+
+  // The shape family's test member is linear's function on GIMP's three-node stencil: node by
+  // node the same weight and derivative, bit for bit (integer coordinates, where linear's
+  // derivative is one-sided, included), and zero on the third node.
+  {
+    std::uniform_real_distribution<double> u(0.0, 7.0);
+    int                                    differ = 0;
+    for (int trial = 0; trial < 1000; ++trial)
+      {
+        const double s = trial < 8 ? double(trial) : (trial < 16 ? trial - 8 + 0.5 : u(rng));
+        double       w_l[2], dw_l[2], w_t[3], dw_t[3];
+        int          f_l, f_t;
+        LinearShape::weights_1d(s, 0.0, f_l, w_l, dw_l);
+        TestWideLinearShape::weights_1d(s, 0.0, f_t, w_t, dw_t);
+        for (int k = 0; k < 3; ++k)
+          {
+            const int    j  = f_t + k - f_l;
+            const double w  = j == 0 || j == 1 ? w_l[j] : 0.0;
+            const double dw = j == 0 || j == 1 ? dw_l[j] : 0.0;
+            differ += w_t[k] != w || dw_t[k] != dw;
+          }
+        differ += f_t != static_cast<int>(std::floor(s + 0.5)) - 1;
+      }
+    std::printf("test wide linear against linear, 1000 coordinates: %d weights or derivatives differ\n", differ);
+    mpm_test::check(differ == 0, "the test member's weights are linear's, node by node");
+  }
 
   // GIMP tends to the linear hat as the particle domain shrinks.
   double w_lin[2], dw_lin[2], w_g[3], dw_g[3];

@@ -22,6 +22,15 @@ namespace mpm
 {
   struct CpdiShape
   {
+    static constexpr const char *name        = "CPDI";
+    static constexpr const char *description = "the linear hats averaged over each point's parallelogram or parallelepiped domain, whose edges follow F, including its rotation and shear";
+    static constexpr ShapeOwner  owner       = ShapeOwner::always;
+    static constexpr bool   point_domain                    = false;
+    // Not a tensor product: a stretched domain reaches any distance (one MPI rank).
+    static constexpr double safe_distance_outside_home_cell = 0.5;
+    static constexpr bool   apic                            = false;
+    static constexpr double apic_inertia_over_h2            = 0;
+    static constexpr bool   in_3d                           = true;
     static constexpr bool tensor_product   = false;
     static constexpr bool tracks_corners   = false; // the domain comes from F (R = F R_0)
     static constexpr int  n_per_direction  = 2;     // linear hats at each corner
@@ -43,6 +52,14 @@ namespace mpm
   // so points made anywhere start with their rectangle).
   struct Cpdi2qShape
   {
+    static constexpr const char *name        = "CPDI2q";
+    static constexpr const char *description = "2D: the same over a quadrilateral whose four corners move with the grid's velocity";
+    static constexpr ShapeOwner  owner       = ShapeOwner::always;
+    static constexpr bool   point_domain                    = false;
+    static constexpr double safe_distance_outside_home_cell = 0.5;
+    static constexpr bool   apic                            = false;
+    static constexpr double apic_inertia_over_h2            = 0;
+    static constexpr bool   in_3d                           = false;
     static constexpr bool tensor_product   = false;
     static constexpr bool tracks_corners   = true;
     static constexpr int  n_per_direction  = 2;

@@ -45,6 +45,16 @@ namespace mpm
   // fold as for the plain cubic (fold_boundary, applied by stencil_weights_1d).
   struct CubicBSplineGimpShape
   {
+    static constexpr const char *name        = "cubic B-spline GIMP";
+    static constexpr const char *description = "the cubic B-spline averaged over each point's axis-aligned domain, five nodes per direction; with GIMP domain update = F_ii, det F or U the domains follow the deformation";
+    static constexpr ShapeOwner  owner       = ShapeOwner::always;
+    static constexpr bool   point_domain                    = true;
+    // It weighs the nodes within 2 + lp of the point: from home cell [c, c + 1] up to node c + 3
+    // once s > c + 1/2, half a cell beyond the ring even from inside the cell (one MPI rank).
+    static constexpr double safe_distance_outside_home_cell = -0.5;
+    static constexpr bool   apic                            = false;
+    static constexpr double apic_inertia_over_h2            = 0;
+    static constexpr bool   in_3d                           = true;
     static constexpr bool tensor_product  = true;
     static constexpr bool tracks_corners  = false;
     static constexpr int  n_per_direction = 5;

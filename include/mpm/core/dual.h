@@ -21,7 +21,7 @@ namespace mpm
     double value = 0;
     double derivative[N] = {};
 
-    MPM_HOST_DEVICE Dual() = default;
+    Dual() = default; // host and device alike (a defaulted constructor takes no annotation)
     MPM_HOST_DEVICE Dual(const double v) // a constant: no derivatives
       : value(v)
     {}

@@ -6,7 +6,7 @@
 // and ranks before any point gets that far.
 #pragma once
 
-#include <mpm/core/shape_functions.h>
+#include <mpm/core/shape/shape_family.h>
 #include <mpm/core/views.h>
 
 namespace mpm
@@ -16,17 +16,12 @@ namespace mpm
   // nodes around them (the vertices of the home cell's neighbours).
   inline double safe_distance_outside_home_cell(const ShapeFunction shape)
   {
-    // GIMP and the quadratic B-spline: stencil first node floor(s + 1/2) - 1, three nodes;
-    // linear: floor(s), two; the cubic B-spline: floor(s) - 1, four, so the point must stay
-    // in its home cell (the points are re-sorted as soon as one leaves it).
-    // The cubic B-spline GIMP weighs the nodes within 2 + lp of the point (lp <= 1/2): from
-    // home cell [c, c + 1] up to node c + 3 once s > c + 1/2, half a cell beyond the ring even
-    // from inside the cell, so its distance is negative. Several ranks refuse it; the nodes
-    // near the material keep further rings (active_node_margin).
-    return shape == ShapeFunction::linear        ? 1.0 :
-           shape == ShapeFunction::bspline3      ? 0.0 :
-           shape == ShapeFunction::bspline3_gimp ? -0.5 :
-                                                   0.5;
+    // Each member's own (shape_traits.h): linear's stencil starts at floor(s), two nodes: 1;
+    // GIMP and the quadratic B-spline at floor(s + 1/2) - 1, three nodes: 1/2; the cubic
+    // B-spline at floor(s) - 1, four nodes: 0, so the point must stay in its home cell.
+    double distance = 0;
+    with_shape(shape, [&](auto member) { distance = decltype(member)::safe_distance_outside_home_cell; });
+    return distance;
   }
 
   // Distance of point i outside its home cell (0 inside), in cell units, max-norm.

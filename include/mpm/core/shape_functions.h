@@ -8,25 +8,23 @@
 #pragma once
 
 #include <mpm/core/config.h>
+#include <mpm/core/shape/shape_traits.h>
 
 #include <cmath>
 
 namespace mpm
 {
-  enum class ShapeFunction : int
-  {
-    linear = 0, // standard MPM: hat functions on the cell containing the point
-    gimp   = 1, // generalised interpolation MP, particle domain of half-length lp
-    bspline2 = 2, // quadratic B-spline, its ghost node at a lattice face folded into the face's nodes
-    bspline3 = 3, // cubic B-spline, the same fold
-    cpdi     = 4, // CPDI: linear hats averaged over a parallelogram / parallelepiped domain following F (cpdi.h)
-    cpdi2q   = 5, // CPDI2q (2D): the same over a quadrilateral whose corners move with the grid (cpdi.h)
-    bspline3_gimp = 6 // the cubic B-spline averaged over each point's domain (cubic_bspline_gimp.h)
-  };
-
   // Standard MPM: the two nodes of the cell containing s.
   struct LinearShape
   {
+    static constexpr const char *name        = "linear";
+    static constexpr const char *description = "standard MPM";
+    static constexpr ShapeOwner  owner       = ShapeOwner::always;
+    static constexpr bool   point_domain                    = false;
+    static constexpr double safe_distance_outside_home_cell = 1.0;
+    static constexpr bool   apic                            = true;
+    static constexpr double apic_inertia_over_h2            = 0;
+    static constexpr bool   in_3d                           = true;
     static constexpr bool tensor_product  = true;
     static constexpr bool tracks_corners  = false;
     static constexpr int  n_per_direction = 2;
@@ -80,6 +78,14 @@ namespace mpm
   // GIMP: the nearest node and its two neighbours cover the support h + lp <= 3h/2.
   struct GimpShape
   {
+    static constexpr const char *name        = "GIMP";
+    static constexpr const char *description = "generalised interpolation";
+    static constexpr ShapeOwner  owner       = ShapeOwner::always;
+    static constexpr bool   point_domain                    = true;
+    static constexpr double safe_distance_outside_home_cell = 0.5;
+    static constexpr bool   apic                            = false;
+    static constexpr double apic_inertia_over_h2            = 0;
+    static constexpr bool   in_3d                           = true;
     static constexpr bool tensor_product  = true;
     static constexpr bool tracks_corners  = false;
     static constexpr int  n_per_direction = 3;
@@ -100,6 +106,14 @@ namespace mpm
   // lattice; fold_boundary (below) removes it.
   struct QuadraticBSplineShape
   {
+    static constexpr const char *name        = "quadratic B-spline";
+    static constexpr const char *description = "C1, three nodes per direction; within half a cell of the grid's faces it becomes linear, doc/theory.md";
+    static constexpr ShapeOwner  owner       = ShapeOwner::always;
+    static constexpr bool   point_domain                    = false;
+    static constexpr double safe_distance_outside_home_cell = 0.5;
+    static constexpr bool   apic                            = true;
+    static constexpr double apic_inertia_over_h2            = 0.25;
+    static constexpr bool   in_3d                           = true;
     static constexpr bool tensor_product  = true;
     static constexpr bool tracks_corners  = false;
     static constexpr int  n_per_direction = 3;
@@ -165,6 +179,14 @@ namespace mpm
   // outside the lattice; fold_boundary (below) removes it.
   struct CubicBSplineShape
   {
+    static constexpr const char *name        = "cubic B-spline";
+    static constexpr const char *description = "C2, four nodes per direction, the same treatment at the faces; in MPI runs the points are re-sorted whenever one leaves its cell";
+    static constexpr ShapeOwner  owner       = ShapeOwner::always;
+    static constexpr bool   point_domain                    = false;
+    static constexpr double safe_distance_outside_home_cell = 0.0;
+    static constexpr bool   apic                            = true;
+    static constexpr double apic_inertia_over_h2            = 1.0 / 3.0;
+    static constexpr bool   in_3d                           = true;
     static constexpr bool tensor_product  = true;
     static constexpr bool tracks_corners  = false;
     static constexpr int  n_per_direction = 4;

@@ -14,7 +14,7 @@
 #include <mpm/core/local_damping.h>
 #include <mpm/core/material/material.h>
 #include <mpm/core/prefetch.h>
-#include <mpm/core/shape_functions.h>
+#include <mpm/core/shape/shape_family.h>
 #include <mpm/core/small_tensor.h>
 #include <mpm/core/stencil_contribution.h>
 #include <mpm/core/step/affine_transfer.h>
@@ -77,8 +77,7 @@ namespace mpm
           throw std::invalid_argument("explicit_step: APIC needs flip_fraction = 0 (its velocity is PIC's)");
         if (p.n_state_variables < s.affine_state_variable + dim * dim)
           throw std::invalid_argument("explicit_step: APIC's affine matrix needs dim x dim state variables");
-        if (s.affine_matrix == AffineMatrix::b_d_inverse && apic_inertia_over_h2<Shape>() == 0 &&
-            !std::is_same_v<Shape, LinearShape>)
+        if (s.affine_matrix == AffineMatrix::b_d_inverse && !Shape::apic)
           throw std::invalid_argument("explicit_step: APIC (B D^-1) needs a shape function with a constant D_p "
                                       "(the B-splines) or linear weights; GIMP has neither (TPIC runs with it)");
       }
@@ -275,30 +274,20 @@ namespace mpm
                                     const Exchange &exchange = Exchange(), bool *averaging_pending = nullptr,
                                     FusedTransfer<dim, Real> *fused = nullptr)
   {
-    if (shape == ShapeFunction::gimp)
-      return explicit_step<dim, GimpShape, physics>(backend, g, p, materials, s, dt, exchange,
-                                                    averaging_pending, fused);
-    if (shape == ShapeFunction::bspline2)
-      return explicit_step<dim, QuadraticBSplineShape, physics>(backend, g, p, materials, s, dt, exchange,
-                                                                averaging_pending, fused);
-    if (shape == ShapeFunction::bspline3)
-      return explicit_step<dim, CubicBSplineShape, physics>(backend, g, p, materials, s, dt, exchange,
-                                                            averaging_pending, fused);
-    if (shape == ShapeFunction::bspline3_gimp)
-      return explicit_step<dim, CubicBSplineGimpShape, physics>(backend, g, p, materials, s, dt, exchange,
-                                                                averaging_pending, fused);
-    if (shape == ShapeFunction::cpdi)
-      return explicit_step<dim, CpdiShape, physics>(backend, g, p, materials, s, dt, exchange,
-                                                    averaging_pending, fused);
-    if (shape == ShapeFunction::cpdi2q)
-      {
-        if constexpr (dim == 2)
-          return explicit_step<dim, Cpdi2qShape, physics>(backend, g, p, materials, s, dt, exchange,
-                                                          averaging_pending, fused);
-        else
-          throw std::invalid_argument("explicit_step: CPDI2q is two-dimensional");
-      }
-    return explicit_step<dim, LinearShape, physics>(backend, g, p, materials, s, dt, exchange,
-                                                    averaging_pending, fused);
+    StepReduction<Real> reduction{};
+    with_shape(shape, [&](auto member) {
+      using Shape = decltype(member);
+      if constexpr (dim == 3 && !Shape::in_3d)
+        throw std::invalid_argument(std::string("explicit_step: ") + Shape::name + " is two-dimensional");
+      else if constexpr (atomic_scatter<Backend>::value && physics != DevicePhysics::all &&
+                         Shape::owner != ShapeOwner::always)
+        throw std::invalid_argument(std::string("explicit_step: the shape function ") + Shape::name +
+                                    " is compiled into the device's DevicePhysics::all kernels only "
+                                    "(shape_needs_all_physics)");
+      else
+        reduction = explicit_step<dim, Shape, physics>(backend, g, p, materials, s, dt, exchange, averaging_pending,
+                                                       fused);
+    });
+    return reduction;
   }
 } // namespace mpm

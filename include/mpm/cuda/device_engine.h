@@ -14,7 +14,7 @@
 #include <mpm/core/diagnostics.h>
 #include <mpm/core/host_storage.h>
 #include <mpm/core/material/material.h>
-#include <mpm/core/shape_functions.h>
+#include <mpm/core/shape/shape_family.h>
 #include <mpm/core/step.h>
 #include <mpm/core/time_step_rule.h>
 #include <mpm/core/views.h>

@@ -6,7 +6,7 @@
 
 #include <mpm/core/domain_update.h>
 #include <mpm/core/material/hencky.h>
-#include <mpm/core/shape_functions.h>
+#include <mpm/core/shape/shape_family.h>
 #include <mpm/core/step/settings.h>
 
 #include <string>

@@ -5,7 +5,7 @@
 
 #include <mpm/core/material/material.h>
 #include <mpm/core/point_fields.h>
-#include <mpm/core/shape_functions.h>
+#include <mpm/core/shape/shape_family.h>
 #include <mpm/core/step/settings.h>
 #include <mpm/dealii/backend_settings.h>
 #include <mpm/dealii/body_settings.h>
@@ -94,6 +94,8 @@ namespace mpm
     // Shape function = CPDI2q: the index of the first of the 4 x dim state variables that hold each
     // point's corners (their offsets from the initial rectangle; after the affine matrix); -1 otherwise.
     int corner_state_variable() const;
+    // The shape function's domain corners are state variables (Cpdi2qShape::tracks_corners).
+    bool tracks_corners() const;
 
     // Declares every entry for a given dimension, number of bodies and material names.
     static void declare(dealii::ParameterHandler &prm, unsigned int dim, unsigned int n_bodies,
@@ -122,6 +124,10 @@ namespace mpm
 
   // Prints every entry (the MPM's and those of `sections`) with its default and documentation
   // (for --print-parameters).
+  // Puts the shape functions owned by `test` (shape_family.h) into Solver/Shape function for the
+  // rest of the process; call it before declaring the parameters. Tests only.
+  void register_test_shapes();
+
   void print_parameters(std::ostream &out, unsigned int dim, const std::string &style,
                         const std::vector<ParameterSection> &sections = {});
 } // namespace mpm

@@ -26,5 +26,8 @@ namespace mpm
     std::vector<double> get_point(dealii::ParameterHandler &prm, const std::string &entry, const std::string &where);
     // "a, b, c"
     std::string join(const std::vector<std::string> &items);
+    // "a, b or c", "a, b and c"
+    std::string join_or(const std::vector<std::string> &items);
+    std::string join_and(const std::vector<std::string> &items);
   } // namespace prm_reading
 } // namespace mpm

@@ -35,12 +35,7 @@ namespace mpm
     template <typename Shape>
     MPM_HOST_DEVICE constexpr double apic_inertia_over_h2()
     {
-      if constexpr (std::is_same_v<Shape, QuadraticBSplineShape>)
-        return 0.25;
-      else if constexpr (std::is_same_v<Shape, CubicBSplineShape>)
-        return 1.0 / 3.0;
-      else
-        return 0;
+      return Shape::apic_inertia_over_h2;
     }
 
     // A point's stencil visited with the weights evaluated on each visit (the device's form,
