@@ -17,8 +17,10 @@ namespace mpm
                       "MPI runs: the points are re-sorted into cells and ranks (migrating to the rank owning their "
                       "new cell) as soon as one point is this fraction of the safe distance outside the cell it was "
                       "sorted into (the safe distance, half a cell for GIMP and one cell for linear shape functions, "
-                      "keeps its stencil within the rank's nodes). 1 = only when needed, 0 = every step. With "
-                      "Solver/Pressure averaging, at most half a cell (the cell sums cover the ghost cells).");
+                      "keeps its stencil within the rank's nodes), and before a point could end the next step beyond "
+                      "the rank's ghost cells (where the re-sort would not find it). 1 = only when needed, 0 = every "
+                      "step. With Solver/Pressure averaging, at most half a cell (the cell sums cover the ghost "
+                      "cells).");
     prm.declare_entry("Load balance threshold", "1.1", Patterns::Double(0),
                       "MPI runs: the grid is repartitioned by work (cells weighted by their points) when the largest "
                       "work of one rank exceeds this multiple of the mean; checked at the start and after each "

@@ -1,6 +1,6 @@
 // The whole explicit step on a CUDA device, behind a plain C++ interface that host
 // code compiled by an ordinary C++ compiler can use: no CUDA and no deal.II header
-// here. The implementation (source/cuda/device_engine.cu, compiled by nvcc into the
+// here. The implementation (source/cuda/device_engine/, one file per job, compiled by nvcc into the
 // static library mpm_cuda_engine) keeps the points and nodes in device memory for
 // the whole run; data crosses to the host only in upload/download (output, end of
 // run, MPI migration), as the few bytes of each step's reduction and, on several MPI

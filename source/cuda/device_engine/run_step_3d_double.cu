@@ -1,0 +1,5 @@
+// DeviceEngine<3, double>::run_step (run_step.cuh).
+#include "run_step.cuh"
+
+template mpm::StepReduction<double>
+mpm::cuda::DeviceEngine<3, double>::run_step(const mpm::StepSettings<3, double> &, double);

@@ -1,0 +1,5 @@
+// DeviceEngine<3, float>::run_step (run_step.cuh).
+#include "run_step.cuh"
+
+template mpm::StepReduction<float>
+mpm::cuda::DeviceEngine<3, float>::run_step(const mpm::StepSettings<3, float> &, float);
