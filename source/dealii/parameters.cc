@@ -247,14 +247,18 @@ namespace mpm
     const std::string s = prm.get("Update scheme");
     scheme = s == "USL" ? UpdateScheme::usl : (s == "USF" ? UpdateScheme::usf : UpdateScheme::musl);
     const std::string shape = prm.get("Shape function");
+    shape_function = ShapeFunction::linear; // the pattern admits only the members' names
     for_each_shape([&](const ShapeFunction tag, auto member) {
       if (shape == decltype(member)::name)
         shape_function = tag;
     });
-    const bool cpdi_family = shape_function == ShapeFunction::cpdi || shape_function == ShapeFunction::cpdi2q;
-    if (shape_function == ShapeFunction::cpdi2q && dim != 2)
-      parameter_error("Solver/Shape function", "CPDI2q is two-dimensional (its domains are quadrilaterals); in 3D use CPDI, "
-                                    "whose parallelepipeds follow F.");
+    // Not a tensor product (CPDI): a domain stretched by the flow reaches any distance.
+    const bool cpdi_family = !shape_is(shape_function, [](auto member) { return decltype(member)::tensor_product; });
+    if (dim == 3 && !shape_is(shape_function, [](auto member) { return decltype(member)::in_3d; }))
+      parameter_error("Solver/Shape function", shape + " is two-dimensional; in 3D use " +
+                                    join_or(shape_names(test_shapes_registered, [](auto member) {
+                                      return decltype(member)::in_3d;
+                                    })) + ".");
     const std::string du = prm.get("GIMP domain update");
     domain_update = du == "det F" ? DomainUpdate::det_F :
                     du == "F_ii"  ? DomainUpdate::stretch :
